@@ -1,0 +1,39 @@
+"""Every tolerance, epsilon and numerical constant of the library, in one place.
+
+Modules import the names they need from here; nothing else in the library hard-codes a threshold.
+Values quoted from the paper or from the reference implementation say so.
+"""
+
+# --- cotangent weights (reference implementation) -------------------------------------------
+#: smallest edge weight kept; smaller (and negative) weights are clamped to this.
+COT_WEIGHT_MIN = 1e-10
+#: weights above this (and NaN) are replaced by COT_WEIGHT_FALLBACK.
+COT_WEIGHT_MAX = 100.0
+#: replacement for NaN or huge cotangent weights.
+COT_WEIGHT_FALLBACK = 1.0
+
+# --- deformation gradients -------------------------------------------------------------------
+#: length of the extra "normal edge", as a fraction of the mean edge length (reference: 0.3).
+NORMAL_EDGE_SCALE = 0.3
+
+# --- mesh validation -------------------------------------------------------------------------
+#: a face whose area is below this fraction of (mean edge length)^2 counts as zero-area.
+DEGENERATE_AREA_RTOL = 1e-12
+
+# --- feature normalisation (paper Sec. 4.1, Eq. 3) -------------------------------------------
+#: features are mapped to [-a, a].
+NORMALIZE_A = 0.9
+#: a constant component c is treated as spanning [c - eps, c + eps].
+NORMALIZE_EPS = 1e-6
+
+# --- mesh VAE (paper Sec. 4.2) ---------------------------------------------------------------
+#: deviation output sigma = SIGMA_MAX * sigmoid(x).
+SIGMA_MAX = 2.0
+#: weight of the reconstruction term in Eq. 4.
+DEFAULT_ALPHA = 1e6
+#: default latent size.
+DEFAULT_LATENT = 128
+#: Adam learning rate.
+DEFAULT_LR = 1e-3
+#: slope of the leaky ReLU on internal layers.
+LEAKY_RELU_SLOPE = 0.1
