@@ -1,0 +1,332 @@
+"""Connectivity of a triangle mesh: edges, one-rings, boundaries, normals and areas.
+
+Everything here depends only on the faces ``F`` (and, for normals and areas, on positions ``V``).
+Edge order is fixed once and for all: :func:`edges` returns the undirected edges ``(i, j)`` with
+``i < j`` in lexicographic order, and :func:`directed_edges` returns every ``(i, j)`` and ``(j, i)``
+sorted by source vertex then target vertex, which is exactly the concatenation of the one-rings
+(:func:`one_rings`). Cotangent weights and the RIMD feature layout follow these orders.
+
+All functions are vectorised (no Python loop over vertices, edges or faces) except
+:func:`boundary_loops`, whose loop runs over boundary edges only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = [
+    "edges",
+    "directed_edges",
+    "face_edge_indices",
+    "edge_index",
+    "one_rings",
+    "boundary_edges",
+    "boundary_vertices",
+    "boundary_loops",
+    "face_normals",
+    "vertex_normals",
+    "face_areas",
+]
+
+
+def _check_faces(F) -> np.ndarray:
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"faces must have shape (n_faces, 3), got {F.shape}")
+    if F.size and not np.issubdtype(F.dtype, np.integer):
+        if not np.all(np.equal(np.mod(F, 1), 0)):
+            raise ValueError("faces must hold integer vertex indices")
+    F = F.astype(np.int64, copy=False)
+    if F.size and F.min() < 0:
+        raise ValueError(f"faces hold a negative vertex index ({F.min()})")
+    return F
+
+
+def _face_half_edges(F: np.ndarray) -> np.ndarray:
+    """Half-edges of every face in face order, ``(3 * n_faces, 2) int64``.
+
+    Row ``3 * f + k`` is the edge from corner ``k`` to corner ``k + 1`` of face ``f``.
+    """
+    return np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
+
+
+def edges(F) -> np.ndarray:
+    """Undirected edges of the mesh.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+        Triangles.
+
+    Returns
+    -------
+    E : (n_edges, 2) int64
+        Each edge once as ``(i, j)`` with ``i < j``, sorted lexicographically.
+    """
+    F = _check_faces(F)
+    he = np.sort(_face_half_edges(F), axis=1)
+    return np.unique(he, axis=0) if len(he) else np.zeros((0, 2), np.int64)
+
+
+def edge_index(E: np.ndarray, i, j) -> np.ndarray:
+    """Index of the undirected edge ``{i, j}`` in the sorted edge list ``E`` (from :func:`edges`).
+
+    Parameters
+    ----------
+    E : (n_edges, 2) int64
+        Output of :func:`edges`.
+    i, j : int or (k,) int
+        End points, in either order.
+
+    Returns
+    -------
+    idx : int64 array of the broadcast shape of ``i`` and ``j``.
+
+    Raises
+    ------
+    ValueError
+        If some pair is not an edge of the mesh.
+    """
+    i = np.asarray(i, dtype=np.int64)
+    j = np.asarray(j, dtype=np.int64)
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    n = int(E.max()) + 1 if len(E) else 1
+    n = max(n, int(hi.max()) + 1 if hi.size else 0)
+    keys = E[:, 0] * n + E[:, 1]
+    q = lo * n + hi
+    pos = np.searchsorted(keys, q)
+    pos_c = np.minimum(pos, len(keys) - 1)
+    ok = (pos < len(keys)) & (keys[pos_c] == q)
+    if not np.all(ok):
+        bad = np.stack([lo, hi], -1).reshape(-1, 2)[~ok.reshape(-1)][0]
+        raise ValueError(f"({bad[0]}, {bad[1]}) is not an edge of the mesh")
+    return pos_c
+
+
+def face_edge_indices(F) -> np.ndarray:
+    """For each face corner ``k``, the index (in :func:`edges`) of the edge *opposite* to it.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    FE : (n_faces, 3) int64
+        ``FE[f, k]`` is the edge joining ``F[f, k+1]`` and ``F[f, k+2]`` (indices mod 3).
+    """
+    F = _check_faces(F)
+    E = edges(F)
+    opp = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1)  # (m, 3, 2)
+    return edge_index(E, opp[..., 0], opp[..., 1])
+
+
+def directed_edges(F) -> np.ndarray:
+    """Directed edges: every undirected edge in both directions.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    D : (2 * n_edges, 2) int64
+        Rows ``(i, j)`` sorted by ``i`` then ``j``; the rows with source ``i`` are the one-ring of
+        ``i`` (see :func:`one_rings`).
+    """
+    E = edges(F)
+    D = np.concatenate([E, E[:, ::-1]], axis=0)
+    order = np.lexsort((D[:, 1], D[:, 0]))
+    return D[order]
+
+
+def one_rings(F, n_vertices: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """One-ring neighbourhoods in compressed (CSR) form.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+    n_vertices : int, optional
+        Number of vertices (default ``F.max() + 1``); isolated vertices get empty rings.
+
+    Returns
+    -------
+    indptr : (n_vertices + 1,) int64
+        The neighbours of vertex ``i`` are ``indices[indptr[i]:indptr[i + 1]]``.
+    indices : (2 * n_edges,) int64
+        Neighbour vertex ids, ascending within each ring; equal to ``directed_edges(F)[:, 1]``.
+    """
+    F = _check_faces(F)
+    n = int(F.max()) + 1 if F.size else 0
+    if n_vertices is None:
+        n_vertices = n
+    if n_vertices < n:
+        raise ValueError(f"n_vertices={n_vertices} but faces reference vertex {n - 1}")
+    D = directed_edges(F)
+    counts = np.bincount(D[:, 0], minlength=n_vertices)
+    indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    return indptr, D[:, 1].copy()
+
+
+def boundary_edges(F) -> np.ndarray:
+    """Boundary half-edges, oriented as in their only face.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    B : (n_boundary_edges, 2) int64
+        Directed edges ``(i, j)`` that belong to exactly one face, in the direction that face
+        traverses them (so a boundary loop is followed by chaining ``j`` to the next ``i``).
+    """
+    F = _check_faces(F)
+    he = _face_half_edges(F)
+    key = np.sort(he, axis=1)
+    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    return he[counts[inv.reshape(-1)] == 1]
+
+
+def boundary_vertices(F) -> np.ndarray:
+    """Vertices on the mesh boundary.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    b : (n_boundary_vertices,) int64
+        Sorted ids of vertices incident to an edge that has only one face. Empty for a closed mesh.
+    """
+    return np.unique(boundary_edges(F).reshape(-1))
+
+
+def boundary_loops(F) -> list[np.ndarray]:
+    """Boundary loops as ordered vertex cycles.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    loops : list of (loop_length,) int64
+        Each loop lists its vertices in the order the adjacent faces traverse the boundary, starting
+        at its smallest vertex id; loops are sorted by that start vertex. Empty for a closed mesh.
+
+    Raises
+    ------
+    ValueError
+        If a boundary vertex has more than one outgoing boundary edge (non-manifold boundary).
+    """
+    B = boundary_edges(F)
+    if len(B) == 0:
+        return []
+    src, dst = B[:, 0], B[:, 1]
+    if len(np.unique(src)) != len(src):
+        vals, c = np.unique(src, return_counts=True)
+        raise ValueError(f"non-manifold boundary at vertex {vals[c > 1][0]}")
+    nxt = dict(zip(src.tolist(), dst.tolist()))
+    loops = []
+    remaining = set(nxt)
+    while remaining:
+        start = min(remaining)
+        loop = [start]
+        remaining.discard(start)
+        v = nxt[start]
+        while v != start:
+            if v not in remaining:
+                raise ValueError(f"boundary does not close into a loop at vertex {v}")
+            loop.append(v)
+            remaining.discard(v)
+            v = nxt[v]
+        loops.append(np.asarray(loop, dtype=np.int64))
+    return loops
+
+
+def _check_positions(V, F) -> tuple[np.ndarray, np.ndarray]:
+    V = np.asarray(V, dtype=np.float64)
+    if V.ndim not in (2, 3) or V.shape[-1] != 3:
+        raise ValueError(
+            f"vertices must have shape (n_vertices, 3) or (n_meshes, n_vertices, 3), got {V.shape}"
+        )
+    F = _check_faces(F)
+    if F.size and F.max() >= V.shape[-2]:
+        raise ValueError(f"faces reference vertex {F.max()} but there are {V.shape[-2]} vertices")
+    return V, F
+
+
+def _face_cross(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """``(p1 - p0) x (p2 - p0)`` per face: ``(..., n_faces, 3)``, length twice the face area."""
+    p0 = V[..., F[:, 0], :]
+    return np.cross(V[..., F[:, 1], :] - p0, V[..., F[:, 2], :] - p0)
+
+
+def face_areas(V, F) -> np.ndarray:
+    """Triangle areas.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    A : (n_faces,) or (n_meshes, n_faces) float64
+    """
+    V, F = _check_positions(V, F)
+    return 0.5 * np.linalg.norm(_face_cross(V, F), axis=-1)
+
+
+def face_normals(V, F) -> np.ndarray:
+    """Unit face normals (right-hand rule on the corner order).
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    N : (n_faces, 3) or (n_meshes, n_faces, 3) float64
+        Zero-area faces get the zero vector (not NaN).
+    """
+    V, F = _check_positions(V, F)
+    c = _face_cross(V, F)
+    norm = np.linalg.norm(c, axis=-1, keepdims=True)
+    return np.divide(c, norm, out=np.zeros_like(c), where=norm > 0)
+
+
+def vertex_normals(V, F) -> np.ndarray:
+    """Area-weighted unit vertex normals.
+
+    Each vertex normal is the normalised sum of the area-weighted normals of its faces.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    N : (n_vertices, 3) or (n_meshes, n_vertices, 3) float64
+        Unit vectors; a vertex with no face (or only zero-area faces) gets the zero vector.
+    """
+    V, F = _check_positions(V, F)
+    n = V.shape[-2]
+    m = len(F)
+    c = _face_cross(V, F)  # (..., m, 3)
+    inc = sp.csr_matrix(
+        (np.ones(3 * m), (F.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m)
+    )
+    if V.ndim == 2:
+        acc = inc @ c
+    else:
+        N = V.shape[0]
+        acc = (inc @ c.transpose(1, 0, 2).reshape(m, N * 3)).reshape(n, N, 3).transpose(1, 0, 2)
+    acc = np.asarray(acc)
+    norm = np.linalg.norm(acc, axis=-1, keepdims=True)
+    return np.divide(acc, norm, out=np.zeros_like(acc), where=norm > 0)
