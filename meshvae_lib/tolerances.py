@@ -37,3 +37,32 @@ DEFAULT_LATENT = 128
 DEFAULT_LR = 1e-3
 #: slope of the leaky ReLU on internal layers.
 LEAKY_RELU_SLOPE = 0.1
+
+# --- applications: embedding (paper Sec. 5.4) ------------------------------------------------
+#: prior deviation of the embedded latent dimensions of the sigma_object model (paper: 0.1).
+EMBEDDING_SIGMA_SMALL = 0.1
+#: neighbours of Neighborhood Preserving Embedding (paper: k = 25).
+NPE_N_NEIGHBORS = 25
+#: regulariser of the local reconstruction weights, times the trace of the local Gram matrix.
+NPE_REG = 1e-3
+#: ridge on X^T X in NPE's generalised eigenproblem, times its mean eigenvalue.
+NPE_REG_EIG = 1e-6
+#: principal components with singular value below this fraction of the largest are dropped (NPE).
+NPE_PCA_RTOL = 1e-8
+#: t-SNE perplexity (paper: 30).
+TSNE_PERPLEXITY = 30.0
+#: t-SNE inputs are reduced to this many principal components first.
+TSNE_PCA_DIMS = 50
+
+# --- applications: exploration (paper Sec. 5.5, Fig. 9) -------------------------------------
+#: prior deviations of the exploration model: first two, next two, the rest.
+EXPLORATION_SIGMA_OBJECT = (0.1, 0.1, 0.5, 0.5)
+#: browsing range of each explored latent dimension.
+EXPLORATION_RANGE = (-2.0, 2.0)
+
+# --- applications: interpolation / implausibility ---------------------------------------------
+#: triangles closer than this fraction of the mean edge length do not count as intersecting
+#: (touching is not crossing).
+SELF_INTERSECTION_RTOL = 1e-9
+#: cross products shorter than this (relative) are treated as parallel axes in the SAT test.
+SAT_PARALLEL_RTOL = 1e-12
