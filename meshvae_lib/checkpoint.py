@@ -1,0 +1,390 @@
+"""A trained mesh VAE with everything needed to use it, and its one-file checkpoint.
+
+:class:`MeshVAEModel` bundles the network (:class:`~meshvae_lib.vae.MeshVAE`), the fitted
+normaliser (Eq. 3), the feature extractor (reference mesh, faces, feature kind and RIMD layout) and
+the condition encoder (label names and encodings), so that applications and notebooks are
+one-liners::
+
+    model = MeshVAEModel(features="rimd").fit(collection)     # or load_model("model.pt")
+    z = model.encode_meshes(collection)                      # (N, D) latent means
+    meshes = model.decode_latent(z)                          # (N, n, 3)
+    model.save("model.pt")
+
+A checkpoint is one file written with ``torch.save`` that holds only tensors, numbers, strings,
+lists and dicts (it loads with ``weights_only=True``: no code runs when reading it), plus a
+checksum of the weights and the reference mesh, so that a corrupted, truncated or foreign file
+gives a clear error instead of a broken model.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .features import ConditionEncoder, FeatureExtractor
+from .normalization import FeatureNormalizer
+from .training import TrainConfig, holdout_mask, pad_sigma_object, train_vae
+from .vae import MeshVAE
+
+__all__ = ["MeshVAEModel", "save_model", "load_model", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
+
+logger = logging.getLogger(__name__)
+
+#: value of the ``format`` entry of every checkpoint.
+CHECKPOINT_FORMAT = "meshvae-checkpoint"
+#: bumped when the layout of the checkpoint changes.
+CHECKPOINT_VERSION = 1
+
+
+def _to_storable(obj):
+    """numpy arrays -> tensors, recursively (so that the file loads with weights_only=True)."""
+    if isinstance(obj, np.ndarray):
+        return torch.from_numpy(np.ascontiguousarray(obj))
+    if isinstance(obj, dict):
+        return {k: _to_storable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_to_storable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _to_numpy(obj):
+    if isinstance(obj, torch.Tensor):
+        return obj.numpy()
+    if isinstance(obj, dict):
+        return {k: _to_numpy(v) for k, v in obj.items()}
+    return obj
+
+
+def _checksum(state_dict: dict, reference: np.ndarray, faces: np.ndarray) -> str:
+    h = hashlib.blake2b(digest_size=16)
+    for key in sorted(state_dict):
+        h.update(key.encode())
+        h.update(state_dict[key].detach().cpu().contiguous().numpy().tobytes())
+    h.update(np.ascontiguousarray(reference, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(faces, dtype=np.int64).tobytes())
+    return h.hexdigest()
+
+
+class MeshVAEModel:
+    """A mesh VAE trained on one collection, ready to encode and decode meshes.
+
+    Parameters
+    ----------
+    features : "rimd" | "aligned" | "coords" (the paper's Table 3; "rimd" is the mesh VAE proper).
+    config : :class:`~meshvae_lib.training.TrainConfig` (defaults when None).
+    labels : label columns to condition on (conditional mesh VAE, Eq. 5); empty: unconditional.
+    holdout_every : hold out every k-th mesh (k >= 2) from training to measure generalisation;
+        0 trains on everything.
+    layout : RIMD layout ("paper" or "compact").
+    reference_index : the reference mesh (default: the first mesh of the collection).
+
+    Attributes (after :meth:`fit` or :func:`load_model`)
+    ----------------------------------------------------
+    network_ : MeshVAE, eval mode, CPU.
+    normalizer_ : FeatureNormalizer (Eq. 3).
+    extractor_ : FeatureExtractor (reference_, faces_, kind, layout).
+    conditions_ : ConditionEncoder (columns, categories).
+    train_conditions_ : (N_train, C) float32, the training meshes' condition vectors (to sample
+        values of columns a user leaves unset).
+    sigma_object_ : (D,) float64 prior deviations (ones for the standard prior).
+    holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
+    history_ : list of per-epoch dicts (see :class:`~meshvae_lib.training.TrainResult`).
+    train_seconds_ : float.
+    """
+
+    def __init__(self, features: str = "rimd", config: TrainConfig | None = None, labels=(),
+                 holdout_every: int = 0, layout: str = "paper", reference_index: int = 0):
+        self.features = features
+        self.config = config
+        self.labels = tuple(labels)
+        self.holdout_every = holdout_every
+        self.layout = layout
+        self.reference_index = reference_index
+
+    # -- training ------------------------------------------------------------------------------
+    def fit(self, collection) -> "MeshVAEModel":
+        """Extract features, normalise them, train the network.
+
+        collection : a MeshCollection / SynthCollection (``vertices (N, n, 3)``, ``faces (F, 3)``,
+        ``labels``). Returns ``self``.
+        """
+        config = self.config or TrainConfig()
+        V = np.asarray(collection.vertices, dtype=np.float64)
+        labels = dict(getattr(collection, "labels", {}) or {})
+        mask = holdout_mask(len(V), self.holdout_every)
+        if mask[self.reference_index]:
+            raise ValueError(f"the reference mesh {self.reference_index} would be held out")
+        if np.sum(~mask) < 2:
+            raise ValueError(f"need at least 2 training meshes, got {int(np.sum(~mask))}")
+        self.extractor_ = FeatureExtractor(self.features, self.layout, self.reference_index)
+        self.extractor_.fit(V, collection.faces)
+        X = self.extractor_.transform(V)
+        self.normalizer_ = FeatureNormalizer().fit(X[~mask])
+        Xn = self.normalizer_.transform(X)
+        missing = [c for c in self.labels if c not in labels]
+        if missing:
+            raise ValueError(f"no label column(s) {missing}; the data has {sorted(labels)}")
+        self.conditions_ = ConditionEncoder(self.labels).fit({c: np.asarray(labels[c])[~mask] for c in self.labels})
+        C = self.conditions_.transform(labels) if self.labels else None
+        result = train_vae(
+            Xn[~mask], None if C is None else C[~mask], config,
+            val_features=Xn[mask] if mask.any() else None,
+            val_conditions=None if C is None or not mask.any() else C[mask],
+        )
+        self.network_ = result.model
+        self.history_ = result.history
+        self.train_seconds_ = result.seconds
+        self.holdout_mask_ = mask
+        self.train_conditions_ = (np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask])
+        so = pad_sigma_object(config.sigma_object, self.network_.latent_dim)
+        self.sigma_object_ = np.ones(self.network_.latent_dim) if so is None else so
+        self.config = config
+        return self
+
+    # -- conditions ----------------------------------------------------------------------------
+    @property
+    def is_conditional(self) -> bool:
+        self._check_fitted()
+        return self.network_.n_conditions > 0
+
+    def _conditions(self, n: int, conditions=None, labels=None) -> torch.Tensor | None:
+        """(n, C) float32 tensor from explicit vectors, a label dict, or None for unconditional."""
+        if not self.is_conditional:
+            if conditions is not None and np.size(conditions):
+                raise ValueError("this model is unconditional; it takes no conditions")
+            return None
+        if conditions is None:
+            if labels is None:
+                raise ValueError(
+                    f"this model is conditional on {self.conditions_.columns}: give labels or conditions"
+                )
+            conditions = self.conditions_.transform(labels)
+        c = np.asarray(conditions, dtype=np.float32)
+        if c.ndim == 1:
+            c = np.broadcast_to(c, (n, c.shape[0]))
+        if c.shape != (n, self.network_.n_conditions):
+            raise ValueError(f"conditions must have shape ({n}, {self.network_.n_conditions}), got {c.shape}")
+        return torch.from_numpy(np.ascontiguousarray(c))
+
+    def condition_vector(self, values: dict | None = None, n: int = 1, seed: int | None = 0) -> np.ndarray:
+        """Condition vectors (n, C) float32 from ``{column: value}``.
+
+        Columns left out take the values of randomly chosen training meshes (drawn with ``seed``),
+        so ``condition_vector({"motion": "run"}, n=8)`` varies the other columns as the data does.
+        """
+        self._check_fitted()
+        values = dict(values or {})
+        unknown = [k for k in values if k not in self.conditions_.columns]
+        if unknown:
+            raise ValueError(f"unknown condition columns {unknown}; the model knows {self.conditions_.columns}")
+        rng = np.random.default_rng(seed)
+        rows = rng.integers(0, len(self.train_conditions_), size=n) if len(self.train_conditions_) else np.zeros(n, int)
+        out = np.array(self.train_conditions_[rows], dtype=np.float32).reshape(n, -1)
+        slices = self.conditions_.column_slices()
+        for col, val in values.items():
+            out[:, slices[col]] = self.conditions_.encode_column(col, np.asarray([val]))[0]
+        return out
+
+    # -- encode / decode -----------------------------------------------------------------------
+    def features_of(self, vertices) -> np.ndarray:
+        """Meshes (N, n, 3) or a collection -> normalised feature rows (N, K) float64."""
+        self._check_fitted()
+        return self.normalizer_.transform(self.extractor_.transform(vertices))
+
+    @torch.no_grad()
+    def encode_meshes(self, vertices, conditions=None, labels=None, return_sigma: bool = False):
+        """Latent means (N, D) float64 of meshes (N, n, 3) or of a collection.
+
+        For a conditional model give ``conditions (N, C)`` or ``labels`` (dict column -> (N,));
+        a collection's own labels are used when neither is given. With ``return_sigma`` also the
+        posterior deviations (N, D).
+        """
+        self._check_fitted()
+        if labels is None and conditions is None and hasattr(vertices, "labels"):
+            labels = vertices.labels if self.is_conditional else None
+        X = self.features_of(vertices)
+        x = torch.from_numpy(X.astype(np.float32))
+        mu, sigma = self.network_.eval().encode(x, self._conditions(len(X), conditions, labels))
+        mu = mu.double().numpy()
+        return (mu, sigma.double().numpy()) if return_sigma else mu
+
+    @torch.no_grad()
+    def decode_latent(self, z, conditions=None, labels=None) -> np.ndarray:
+        """Latent vectors (N, D) or (D,) -> meshes (N, n, 3) or (n, 3) float64."""
+        self._check_fitted()
+        z = np.asarray(z, dtype=np.float32)
+        single = z.ndim == 1
+        z2 = z[None] if single else z
+        if z2.ndim != 2 or z2.shape[1] != self.network_.latent_dim:
+            raise ValueError(f"latent vectors must have shape (N, {self.network_.latent_dim}), got {z.shape}")
+        rows = self.network_.eval().decode(torch.from_numpy(np.ascontiguousarray(z2)),
+                                           self._conditions(len(z2), conditions, labels))
+        V = self.extractor_.inverse_transform(self.normalizer_.inverse_transform(rows.double().numpy()))
+        return V[0] if single else V
+
+    def reconstruct(self, vertices, conditions=None, labels=None) -> np.ndarray:
+        """Encode to the latent means and decode: meshes (N, n, 3) -> (N, n, 3) float64."""
+        if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
+            labels = vertices.labels
+        z = self.encode_meshes(vertices, conditions, labels)
+        return self.decode_latent(z, conditions, labels)
+
+    def sample_latent(self, n: int, seed: int = 0) -> np.ndarray:
+        """n draws from the prior N(0, diag(sigma_object^2)): (n, D) float64."""
+        self._check_fitted()
+        if n < 1:
+            raise ValueError(f"n must be >= 1, got {n}")
+        rng = np.random.default_rng(seed)
+        return rng.standard_normal((n, self.network_.latent_dim)) * self.sigma_object_
+
+    def generate(self, n: int, seed: int = 0, condition: dict | None = None) -> np.ndarray:
+        """n new meshes (n, V, 3) decoded from prior samples (Sec. 5, "Generation").
+
+        ``condition``: ``{column: value}`` for a conditional model (unset columns are drawn from
+        the training labels).
+        """
+        z = self.sample_latent(n, seed)
+        if not self.is_conditional:
+            if condition:
+                raise ValueError("this model is unconditional; it takes no condition")
+            return self.decode_latent(z)
+        return self.decode_latent(z, conditions=self.condition_vector(condition, n=n, seed=seed))
+
+    # -- persistence ---------------------------------------------------------------------------
+    def save(self, path) -> Path:
+        """Write the checkpoint (one file, written atomically). Returns the path."""
+        return save_model(path, self)
+
+    @classmethod
+    def load(cls, path, collection=None) -> "MeshVAEModel":
+        return load_model(path, collection)
+
+    def check_compatible(self, collection) -> None:
+        """ValueError unless ``collection`` has this model's mesh (and its label columns)."""
+        self._check_fitted()
+        self.extractor_.check_compatible(collection)
+        if self.is_conditional:
+            labels = getattr(collection, "labels", {}) or {}
+            missing = [c for c in self.conditions_.columns if c not in labels]
+            if missing:
+                raise ValueError(f"the model is conditional on {missing}, which the data lacks (has {sorted(labels)})")
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "network_"):
+            raise ValueError("this MeshVAEModel is not trained yet: call fit(collection) or load_model(path)")
+
+    def __repr__(self) -> str:
+        if not hasattr(self, "network_"):
+            return f"MeshVAEModel(features={self.features!r}, unfitted)"
+        net = self.network_
+        return (f"MeshVAEModel(features={self.extractor_.kind!r}, n_vertices={len(self.extractor_.reference_)},"
+                f" K={net.n_features}, latent={net.latent_dim}, hidden={list(net.hidden)},"
+                f" conditions={self.conditions_.columns})")
+
+
+def save_model(path, model: MeshVAEModel) -> Path:
+    """Write ``model`` to ``path`` as one checkpoint file. Returns the path.
+
+    The file is written next to its destination and renamed, so an interrupted save never leaves a
+    half-written checkpoint under the final name.
+    """
+    model._check_fitted()
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+    state = {k: v.detach().cpu().clone() for k, v in model.network_.state_dict().items()}
+    ext = model.extractor_.state_dict()
+    payload = {
+        "format": CHECKPOINT_FORMAT,
+        "version": CHECKPOINT_VERSION,
+        "torch_version": str(torch.__version__),
+        "network_config": model.network_.config(),
+        "network_state": state,
+        "normalizer": _to_storable(model.normalizer_.state_dict()),
+        "extractor": _to_storable(ext),
+        "conditions": model.conditions_.state_dict(),
+        "train_conditions": torch.from_numpy(np.ascontiguousarray(model.train_conditions_, dtype=np.float32)),
+        "sigma_object": torch.from_numpy(np.asarray(model.sigma_object_, dtype=np.float64)),
+        "train_config": (model.config or TrainConfig()).to_dict(),
+        "estimator": {"features": model.features, "labels": list(model.labels),
+                      "holdout_every": int(model.holdout_every), "layout": model.layout,
+                      "reference_index": int(model.reference_index)},
+        "holdout_mask": torch.from_numpy(np.asarray(model.holdout_mask_, dtype=bool)),
+        "history": [dict(h) for h in getattr(model, "history_", [])],
+        "train_seconds": float(getattr(model, "train_seconds_", 0.0)),
+        "checksum": _checksum(state, ext["reference"], ext["faces"]),
+    }
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        torch.save(payload, tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def load_model(path, collection=None) -> MeshVAEModel:
+    """Read a checkpoint written by :func:`save_model`.
+
+    path : the checkpoint file.
+    collection : optional data the model will be used with; a mesh with another vertex count or
+        connectivity (or lacking the model's label columns) raises ValueError.
+
+    Raises FileNotFoundError for a missing file and ValueError for a file that is not a mesh VAE
+    checkpoint, is corrupted or truncated, or was written by a newer version.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no checkpoint file at {path}")
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except (RuntimeError, EOFError, OSError, ValueError, zipfile.BadZipFile, KeyError, IndexError,
+            AttributeError, TypeError, UnicodeDecodeError, ImportError) as exc:
+        raise ValueError(f"{path} is not a readable mesh VAE checkpoint (corrupted, truncated or another"
+                         f" kind of file): {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}") from exc
+    except Exception as exc:  # the unpickler raises its own error types for foreign pickles
+        if type(exc).__module__.startswith(("pickle", "_pickle")) or "Unpickl" in type(exc).__name__:
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ValueError(f"{path} is not a mesh VAE checkpoint (it holds objects a checkpoint never"
+                             f" holds): {first}") from exc
+        raise
+    if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
+        raise ValueError(f"{path} is not a mesh VAE checkpoint (no '{CHECKPOINT_FORMAT}' marker)")
+    if int(payload.get("version", -1)) > CHECKPOINT_VERSION:
+        raise ValueError(f"{path} was written by a newer version (checkpoint format {payload['version']},"
+                         f" this library reads up to {CHECKPOINT_VERSION})")
+    try:
+        ext_state = _to_numpy(payload["extractor"])
+        state = payload["network_state"]
+        if _checksum(state, ext_state["reference"], ext_state["faces"]) != payload["checksum"]:
+            raise ValueError(f"{path} is corrupted: its weights do not match the stored checksum")
+        model = MeshVAEModel(**payload["estimator"], config=TrainConfig(**{**payload["train_config"], "progress": False}))
+        net_cfg = dict(payload["network_config"])
+        model.network_ = MeshVAE(**net_cfg)
+        model.network_.load_state_dict(state)
+        model.network_.eval()
+        model.normalizer_ = FeatureNormalizer.from_state_dict(_to_numpy(payload["normalizer"]))
+        model.extractor_ = FeatureExtractor.from_state_dict(ext_state)
+        model.conditions_ = ConditionEncoder.from_state_dict(payload["conditions"])
+        model.train_conditions_ = payload["train_conditions"].numpy()
+        model.sigma_object_ = payload["sigma_object"].numpy()
+        model.holdout_mask_ = payload["holdout_mask"].numpy()
+        model.history_ = list(payload["history"])
+        model.train_seconds_ = float(payload["train_seconds"])
+    except (KeyError, TypeError, RuntimeError) as exc:
+        raise ValueError(f"{path} is an incomplete or inconsistent mesh VAE checkpoint: {exc!r}") from exc
+    sizes = (model.normalizer_.n_features_in_, model.extractor_.n_features_, model.network_.n_features)
+    if len(set(sizes)) != 1 or model.conditions_.n_conditions_ != model.network_.n_conditions:
+        raise ValueError(f"{path} is inconsistent: feature lengths {sizes}")
+    if collection is not None:
+        model.check_compatible(collection)
+    return model

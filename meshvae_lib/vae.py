@@ -1,0 +1,214 @@
+"""The mesh VAE network, its KL term and its loss (paper Sec. 4.2-4.4, Eqs. 4 and 5).
+
+Architecture (Sec. 4.2, "Network structure"): a fully connected encoder and decoder. Every
+*internal* layer is ``Linear -> BatchNorm1d -> LeakyReLU``. The encoder ends in two heads, the mean
+``mu`` (no activation) and the deviation ``sigma = sigma_max * sigmoid(.)`` (sigma_max = 2, so that
+sigma can cover the prior's 1). The decoder ends in ``tanh``, matching features normalised to
+[-a, a] (Eq. 3). With ``hidden=()`` (the default) the encoder is one linear map K -> 2D and the
+decoder one linear map D -> K, so there are no internal layers.
+
+Conditional mesh VAE (Sec. 4.3, Eq. 5): a condition vector c (one-hot labels or any given vector)
+is concatenated to the encoder's input and to the decoder's input.
+
+Extended model (Sec. 4.4): the prior is N(0, diag(sigma_object^2)).
+
+Loss (Eq. 4), for a batch of M meshes with K features each::
+
+    L = alpha / (2 M K) * sum_j sum_i (f^_i^j - f~_i^j)^2  +  (1/M) sum_j KL(q(z | f~^j) || p(z))
+
+i.e. both terms are *means over the meshes of the batch*: the loss is the batch average of the
+per-mesh quantity ``alpha/(2K) |f^ - f~|^2 + KL_j``, where ``KL_j`` sums over the D latent
+dimensions. The mean is taken the same way for both terms, so the balance set by alpha does not
+depend on the batch size.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import torch
+from torch import nn
+
+from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
+
+__all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
+
+
+def _block(n_in: int, n_out: int, slope: float) -> list[nn.Module]:
+    return [nn.Linear(n_in, n_out), nn.BatchNorm1d(n_out), nn.LeakyReLU(slope)]
+
+
+class MeshVAE(nn.Module):
+    """Fully connected (conditional) variational autoencoder on normalised mesh features.
+
+    Parameters
+    ----------
+    n_features : int
+        K, the length of a feature row.
+    latent_dim : int
+        D, the size of the latent vector z (paper: 128).
+    hidden : sequence of int
+        sizes of the internal encoder layers, outermost first; the decoder mirrors them.
+        Default ``()``: no internal layer (see ``docs/vae.md`` for the measurements behind it).
+    n_conditions : int
+        C, the length of the condition vector (0: unconditional).
+    sigma_max : float
+        upper bound of the deviation output (paper: 2).
+    negative_slope : float
+        slope of the leaky ReLUs.
+    """
+
+    def __init__(
+        self,
+        n_features: int,
+        latent_dim: int = DEFAULT_LATENT,
+        hidden: Sequence[int] = (),
+        n_conditions: int = 0,
+        sigma_max: float = SIGMA_MAX,
+        negative_slope: float = LEAKY_RELU_SLOPE,
+    ):
+        super().__init__()
+        hidden = tuple(int(h) for h in hidden)
+        for name, value in (("n_features", n_features), ("latent_dim", latent_dim)):
+            if int(value) < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value}")
+        if int(n_conditions) < 0:
+            raise ValueError(f"n_conditions must be >= 0, got {n_conditions}")
+        if any(h < 1 for h in hidden):
+            raise ValueError(f"hidden layer sizes must be positive, got {hidden}")
+        if not sigma_max > 0:
+            raise ValueError(f"sigma_max must be positive, got {sigma_max}")
+        self.n_features = int(n_features)
+        self.latent_dim = int(latent_dim)
+        self.hidden = hidden
+        self.n_conditions = int(n_conditions)
+        self.sigma_max = float(sigma_max)
+        self.negative_slope = float(negative_slope)
+
+        layers: list[nn.Module] = []
+        width = self.n_features + self.n_conditions
+        for h in hidden:
+            layers += _block(width, h, negative_slope)
+            width = h
+        self.encoder_body = nn.Sequential(*layers)
+        # one matrix for both heads: a single (cheaper) matmul over the K inputs
+        self.encoder_head = nn.Linear(width, 2 * self.latent_dim)
+
+        layers = []
+        width = self.latent_dim + self.n_conditions
+        for h in reversed(hidden):
+            layers += _block(width, h, negative_slope)
+            width = h
+        self.decoder_body = nn.Sequential(*layers)
+        self.decoder_head = nn.Linear(width, self.n_features)
+
+    # -- configuration -------------------------------------------------------------------------
+    def config(self) -> dict:
+        """Constructor arguments, enough to rebuild the network: ``MeshVAE(**net.config())``."""
+        return {
+            "n_features": self.n_features,
+            "latent_dim": self.latent_dim,
+            "hidden": list(self.hidden),
+            "n_conditions": self.n_conditions,
+            "sigma_max": self.sigma_max,
+            "negative_slope": self.negative_slope,
+        }
+
+    def _with_condition(self, x: torch.Tensor, c, width: int, what: str) -> torch.Tensor:
+        if x.ndim != 2 or x.shape[1] != width:
+            raise ValueError(f"{what} must have shape (batch, {width}), got {tuple(x.shape)}")
+        if self.n_conditions == 0:
+            if c is not None and c.numel() > 0:
+                raise ValueError("this network is unconditional; got a condition tensor")
+            return x
+        if c is None:
+            raise ValueError(f"this network is conditional: give a condition of shape (batch, {self.n_conditions})")
+        if c.ndim != 2 or c.shape != (x.shape[0], self.n_conditions):
+            raise ValueError(
+                f"condition must have shape ({x.shape[0]}, {self.n_conditions}), got {tuple(c.shape)}"
+            )
+        return torch.cat([x, c.to(x.dtype)], dim=1)
+
+    # -- the four steps ------------------------------------------------------------------------
+    def encode(self, x: torch.Tensor, c: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """Probabilistic encoder q(z | x, c).
+
+        x : (B, K) float32 normalised features; c : (B, C) float32 or None.
+        Returns mu : (B, D) and sigma : (B, D) float32, 0 < sigma < sigma_max.
+        """
+        h = self.encoder_body(self._with_condition(x, c, self.n_features, "features"))
+        out = self.encoder_head(h)
+        mu, s = out[:, : self.latent_dim], out[:, self.latent_dim :]
+        return mu, self.sigma_max * torch.sigmoid(s)
+
+    def reparameterize(
+        self, mu: torch.Tensor, sigma: torch.Tensor, generator: torch.Generator | None = None
+    ) -> torch.Tensor:
+        """z = mu + sigma * eps, eps ~ N(0, I) drawn from ``generator``. (B, D) -> (B, D)."""
+        eps = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+        return mu + sigma * eps
+
+    def decode(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
+        """Probabilistic decoder's mean: z (B, D) [+ c (B, C)] -> features (B, K) in (-1, 1)."""
+        h = self.decoder_body(self._with_condition(z, c, self.latent_dim, "latent vectors"))
+        return torch.tanh(self.decoder_head(h))
+
+    def forward(
+        self, x: torch.Tensor, c: torch.Tensor | None = None, generator: torch.Generator | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Encode, sample z, decode. Returns (x_hat (B, K), mu (B, D), sigma (B, D))."""
+        mu, sigma = self.encode(x, c)
+        z = self.reparameterize(mu, sigma, generator)
+        return self.decode(z, c), mu, sigma
+
+
+def kl_divergence(
+    mu: torch.Tensor, sigma: torch.Tensor, sigma_object: torch.Tensor | None = None
+) -> torch.Tensor:
+    """KL( N(mu, diag sigma^2) || N(0, diag sigma_object^2) ), summed over the latent dimensions.
+
+    Exact closed form, per dimension::
+
+        1/2 [ (sigma^2 + mu^2) / sigma_object^2 - 1 - log(sigma^2 / sigma_object^2) ]
+
+    With ``sigma_object=None`` the prior is N(0, I) (paper Eq. 4). The authors' sibling code
+    writes ``1/2 [mu^2 + (sigma/sigma_object)^2 - log((sigma/sigma_object)^2) - 1]``, which does not
+    divide mu^2 by sigma_object^2: it shrinks the posterior's width in the chosen dimensions but
+    not the spread of their means. Here the exact KL is used (Sec. 4.4).
+
+    mu, sigma : (B, D) float tensors, sigma > 0; sigma_object : (D,) positive or None.
+    Returns (B,) KL per sample.
+    """
+    if mu.shape != sigma.shape:
+        raise ValueError(f"mu and sigma must have the same shape, got {tuple(mu.shape)} and {tuple(sigma.shape)}")
+    var = sigma * sigma
+    if sigma_object is None:
+        return 0.5 * torch.sum(var + mu * mu - 1.0 - torch.log(var), dim=-1)
+    so = torch.as_tensor(sigma_object, dtype=mu.dtype, device=mu.device)
+    if so.shape != mu.shape[-1:]:
+        raise ValueError(f"sigma_object must have shape ({mu.shape[-1]},), got {tuple(so.shape)}")
+    var_o = so * so
+    return 0.5 * torch.sum((var + mu * mu) / var_o - 1.0 - torch.log(var / var_o), dim=-1)
+
+
+def vae_loss(
+    x_hat: torch.Tensor,
+    x: torch.Tensor,
+    mu: torch.Tensor,
+    sigma: torch.Tensor,
+    alpha: float = DEFAULT_ALPHA,
+    sigma_object: torch.Tensor | None = None,
+) -> dict[str, torch.Tensor]:
+    """Mesh VAE loss (Eq. 4; Eq. 5 for the conditional model, whose prior does not depend on c).
+
+    x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D).
+    Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2,
+    ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise), and ``mse`` =
+    mean squared error per component (for logging; alpha-free).
+    """
+    if x_hat.shape != x.shape or x.ndim != 2:
+        raise ValueError(f"x_hat and x must be (M, K) of the same shape, got {tuple(x_hat.shape)} and {tuple(x.shape)}")
+    mse = torch.mean((x_hat - x) ** 2)
+    reconstruction = 0.5 * alpha * mse
+    kl = torch.mean(kl_divergence(mu, sigma, sigma_object))
+    return {"total": reconstruction + kl, "reconstruction": reconstruction, "kl": kl, "mse": mse.detach()}
