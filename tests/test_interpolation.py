@@ -1,0 +1,210 @@
+"""Interpolation paths and implausibility measures (paper Sec. 5.3, Fig. 6)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from meshvae_lib import interpolation as itp
+
+
+def _grid_mesh(n=6, size=1.0):
+    """A flat (n x n)-vertex square grid in the z = 0 plane, two triangles per cell."""
+    x, y = np.meshgrid(np.linspace(0, size, n), np.linspace(0, size, n), indexing="ij")
+    V = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    F = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return V, F.astype(np.int64)
+
+
+# ---------------------------------------------------------------------------------------------
+# paths
+# ---------------------------------------------------------------------------------------------
+
+
+def test_linear_steps_ends_and_midpoint(rng):
+    a, b = rng.normal(size=(4, 3)), rng.normal(size=(4, 3))
+    P = itp.linear_steps(a, b, 5)
+    assert P.shape == (5, 4, 3) and P.dtype == np.float64
+    np.testing.assert_allclose(P[0], a, atol=0)
+    np.testing.assert_allclose(P[-1], b, atol=1e-15)
+    np.testing.assert_allclose(P[2], 0.5 * (a + b), atol=1e-15)
+    with pytest.raises(ValueError, match="n_steps"):
+        itp.linear_steps(a, b, 1)
+    with pytest.raises(ValueError, match=r"\(4, 3\) and \(3,\)"):
+        itp.linear_steps(a, b[0], 3)
+
+
+def test_coordinates_aligns_b_first(rng):
+    V = rng.normal(size=(20, 3))
+    R = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])  # 90 degrees about z
+    seq = itp.interpolate_coordinates(V, V @ R.T + 3.0, 4)
+    # B is a rigid copy of A: after alignment every step is A (no shrinking through the middle)
+    np.testing.assert_allclose(seq, np.broadcast_to(V, seq.shape), atol=1e-10)
+    raw = itp.interpolate_coordinates(V, V @ R.T, 3, align=False)
+    np.testing.assert_allclose(raw[1], 0.5 * (V + V @ R.T), atol=1e-15)
+
+
+def test_feature_and_latent_interpolation_use_the_callables(rng):
+    f_a, f_b = rng.normal(size=6), rng.normal(size=6)
+    seq = itp.interpolate_features(f_a, f_b, 3, lambda f: f.reshape(-1, 2, 3))
+    np.testing.assert_allclose(seq[1].ravel(), 0.5 * (f_a + f_b), atol=1e-15)
+
+    W = rng.normal(size=(6, 2))
+    encode = lambda X: (X @ W, None)  # noqa: E731  linear "encoder" on (2, 6) inputs
+    decode = lambda Z: (Z @ W.T).reshape(-1, 2, 3)  # noqa: E731
+    z, V = itp.interpolate_latent(encode, decode, f_a, f_b, 5)
+    assert z.shape == (5, 2) and V.shape == (5, 2, 3)
+    np.testing.assert_allclose(z[0], f_a @ W, atol=1e-12)
+    np.testing.assert_allclose(z[-1], f_b @ W, atol=1e-12)
+    np.testing.assert_allclose(np.diff(z, axis=0), np.diff(z, axis=0)[:1].repeat(4, 0), atol=1e-12)
+
+
+# ---------------------------------------------------------------------------------------------
+# edge-length distortion
+# ---------------------------------------------------------------------------------------------
+
+
+def test_edge_length_distortion_against_brute_force(rng):
+    V, F = _grid_mesh(4)
+    data = V[None] + 0.05 * rng.normal(size=(7, 16, 3))
+    query = V[None] + 0.05 * rng.normal(size=(3, 16, 3))
+    d, nn = itp.edge_length_distortion(query, F, data)
+    from meshvae_lib.topology import edges
+
+    E = edges(F)
+    for q in range(3):
+        best, arg = np.inf, -1
+        for m in range(7):
+            lq = [np.linalg.norm(query[q, i] - query[q, j]) for i, j in E]
+            lm = [np.linalg.norm(data[m, i] - data[m, j]) for i, j in E]
+            val = np.mean([abs(x - y) / y for x, y in zip(lq, lm)])
+            if val < best:
+                best, arg = val, m
+        assert d[q] == pytest.approx(best, rel=1e-12)
+        assert nn[q] == arg
+
+
+def test_edge_length_distortion_rigid_invariance_and_scale(rng):
+    V, F = _grid_mesh(4)
+    data = np.stack([V, 2.0 * V])
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    d, nn = itp.edge_length_distortion(V @ Q.T + 1.0, F, data)
+    assert d == pytest.approx(0.0, abs=1e-12) and nn == 0
+    d, nn = itp.edge_length_distortion(1.5 * V, F, data)  # every edge 50% longer than V's
+    assert d == pytest.approx(0.25, abs=1e-12) and nn == 1  # 25% shorter than 2V's
+    with pytest.raises(ValueError, match="dataset"):
+        itp.edge_length_distortion(V, F, V)
+
+
+# ---------------------------------------------------------------------------------------------
+# self-intersections
+# ---------------------------------------------------------------------------------------------
+
+
+def _segment_hits_triangle(p, q, a, b, c):
+    """Naive Moller-Trumbore test of segment pq against triangle abc (strict interior)."""
+    d = q - p
+    e1, e2 = b - a, c - a
+    h = np.cross(d, e2)
+    det = e1 @ h
+    if abs(det) < 1e-14:
+        return False
+    s = p - a
+    u = (s @ h) / det
+    qv = np.cross(s, e1)
+    v = (d @ qv) / det
+    t = (e2 @ qv) / det
+    return 0 < u and 0 < v and u + v < 1 and 0 < t < 1
+
+
+def _naive_count(V, F):
+    """All pairs, one by one: non-coplanar triangles in general position cross iff an edge of one
+    pierces the other."""
+    n = 0
+    for i in range(len(F)):
+        for j in range(i + 1, len(F)):
+            if set(F[i]) & set(F[j]):
+                continue
+            A, B = V[F[i]], V[F[j]]
+            hit = any(_segment_hits_triangle(A[k], A[(k + 1) % 3], *B) for k in range(3)) or any(
+                _segment_hits_triangle(B[k], B[(k + 1) % 3], *A) for k in range(3)
+            )
+            n += hit
+    return n
+
+
+def test_two_triangles_hand_made():
+    F = np.array([[0, 1, 2], [3, 4, 5]])
+    A = np.array([[0.0, 0, 0], [2, 0, 0], [0, 2, 0]])
+    crossing = np.array([[0.5, 0.5, -1], [0.5, 0.5, 1], [3, 3, 1]])  # pierces A at (0.5, 0.5, 0)
+    assert itp.self_intersections(np.vstack([A, crossing]), F) == 1
+    above = crossing + [0, 0, 1.5]
+    assert itp.self_intersections(np.vstack([A, above]), F) == 0
+    # coplanar triangles count as touching (no thickness), overlapping or not; a slight tilt that
+    # makes the smaller one pass through A is a crossing
+    assert itp.self_intersections(np.vstack([A, A * 0.5 + [0.2, 0.2, 0]]), F) == 0
+    tilted = A * 0.5 + [0.2, 0.2, 0]
+    tilted[:, 2] = [-0.1, 0.1, 0.1]
+    assert itp.self_intersections(np.vstack([A, tilted]), F) == 1
+    assert itp.self_intersections(np.vstack([A, A + [5, 0, 0]]), F) == 0
+    # touching at a point (corner on the face) is not crossing
+    touch = np.array([[0.5, 0.5, 0], [0.5, 0.5, 1], [1, 2, 1]])
+    assert itp.self_intersections(np.vstack([A, touch]), F) == 0
+
+
+def test_adjacent_faces_never_count():
+    V, F = _grid_mesh(5)
+    assert itp.self_intersections(V, F) == 0
+    # folding the grid sharply keeps adjacent faces touching; still no crossing
+    V2 = V.copy()
+    V2[:, 2] = np.where(V[:, 0] > 0.5, (V[:, 0] - 0.5) * 3, 0)
+    assert itp.self_intersections(V2, F) == 0
+
+
+def test_triangle_soup_against_brute_force(rng):
+    m = 120
+    centers = rng.uniform(0, 3, size=(m, 1, 3))
+    V = (centers + 0.4 * rng.normal(size=(m, 3, 3))).reshape(-1, 3)
+    F = np.arange(3 * m).reshape(m, 3)
+    count, pairs = itp.self_intersections(V, F, return_pairs=True)
+    assert count == _naive_count(V, F)
+    assert count > 10  # the case is not trivial
+    assert pairs.shape == (count, 2) and np.all(pairs[:, 0] < pairs[:, 1])
+
+
+def test_folded_sheet_counts_crossings():
+    # a grid whose right half is folded back through the left half crosses itself
+    V, F = _grid_mesh(7)
+    V2 = V.copy()
+    right = V[:, 0] > 0.5
+    V2[right, 0] = 1.0 - V[right, 0] - 0.05
+    V2[right, 2] = 0.3 * np.sin(3 * V[right, 1]) - 0.1
+    V2[~right, 2] = 0.2 * np.sin(4 * V[~right, 1] + 1)
+    assert itp.self_intersections(V2, F) == _naive_count(V2, F) > 0
+
+
+def test_candidate_pairs_are_a_superset(rng):
+    m = 80
+    V = (rng.uniform(0, 2, size=(m, 1, 3)) + 0.3 * rng.normal(size=(m, 3, 3))).reshape(-1, 3)
+    F = np.arange(3 * m).reshape(m, 3)
+    cand = {tuple(p) for p in itp.candidate_triangle_pairs(V, F)}
+    tri = V[F]
+    lo, hi = tri.min(1), tri.max(1)
+    for i in range(m):
+        for j in range(i + 1, m):
+            overlap = np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]))
+            assert ((i, j) in cand) == overlap
+
+
+def test_batch_and_implausibility_table(rng):
+    V, F = _grid_mesh(4)
+    seq = {"a": np.stack([V, V * 1.1]), "b": np.stack([V, V])}
+    table = itp.implausibility(seq, F, V[None])
+    np.testing.assert_array_equal(table.self_intersections["a"], [0, 0])
+    np.testing.assert_allclose(table.edge_distortion["a"], [0.0, 0.1], atol=1e-12)
+    rows = table.rows()
+    assert rows[0]["method"] == "a" and rows[0]["max edge distortion"] == pytest.approx(0.1)
+    md = table.to_markdown()
+    assert md.count("\n") == 3 and "| a |" in md
