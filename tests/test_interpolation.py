@@ -164,7 +164,7 @@ def test_adjacent_faces_never_count():
 
 
 def test_triangle_soup_against_brute_force(rng):
-    m = 120
+    m = 90
     centers = rng.uniform(0, 3, size=(m, 1, 3))
     V = (centers + 0.4 * rng.normal(size=(m, 3, 3))).reshape(-1, 3)
     F = np.arange(3 * m).reshape(m, 3)
