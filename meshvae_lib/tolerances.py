@@ -66,3 +66,29 @@ EXPLORATION_RANGE = (-2.0, 2.0)
 SELF_INTERSECTION_RTOL = 1e-9
 #: cross products shorter than this (relative) are treated as parallel axes in the SAT test.
 SAT_PARALLEL_RTOL = 1e-12
+
+# --- geometry core: deformation gradients, rotations, reconstruction (issue 2) ----------------
+#: weight of the extra normal "edge" in the fit of T_i, relative to the cotangent weights
+#: c_ij = cot a + cot b (an equilateral one-ring has c_ij = 1.15).
+NORMAL_EDGE_WEIGHT = 1.0
+#: polar decomposition: Newton iterations at most, of which the first few are scaled (Higham 1986).
+POLAR_MAX_ITERATIONS = 40
+POLAR_SCALED_ITERATIONS = 8
+#: stop Newton when no entry changes by more than this.
+POLAR_CONVERGENCE = 1e-15
+#: |det T| below this times |T|_F^3 counts as singular (SVD fallback).
+POLAR_SINGULAR_RTOL = 1e-12
+#: a Newton result farther than this from orthogonal is redone by SVD.
+POLAR_ORTHOGONALITY_TOL = 1e-10
+#: below this angle (rad) SO(3) exp/log use their Taylor series.
+SO3_SMALL_ANGLE = 1e-4
+#: log: when cos(theta) is below this, the axis comes from the symmetric part of R (near pi).
+SO3_NEAR_PI_COS = -0.7
+#: rotation recovery: stop the global (Lie-algebra least-squares) sweeps once every correction
+#: is below this many radians.
+ROTATION_SYNC_TOL = 1e-13
+#: rotation recovery: at most this many global sweeps.
+ROTATION_SYNC_MAX_SWEEPS = 3
+#: rotation recovery: stop the sweeps once the largest correction (rad) is below this (the next
+#: Gauss-Newton correction would be of its square: 1e-6 rad).
+ROTATION_SYNC_STEP_TOL = 1e-3

@@ -26,6 +26,7 @@ __all__ = [
     "boundary_loops",
     "face_normals",
     "vertex_normals",
+    "vertex_normal_sums",
     "face_areas",
 ]
 
@@ -316,6 +317,26 @@ def vertex_normals(V, F) -> np.ndarray:
         Unit vectors; a vertex with no face (or only zero-area faces) gets the zero vector.
     """
     V, F = _check_positions(V, F)
+    acc = vertex_normal_sums(V, F)
+    norm = np.linalg.norm(acc, axis=-1, keepdims=True)
+    return np.divide(acc, norm, out=np.zeros_like(acc), where=norm > 0)
+
+
+def vertex_normal_sums(V, F) -> np.ndarray:
+    """Unnormalised area-weighted vertex normals: sum over incident faces of ``2 area_f n_f``.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    S : (n_vertices, 3) or (n_meshes, n_vertices, 3) float64
+        Sum of the face cross products ``(p1 - p0) x (p2 - p0)`` around each vertex; it scales with
+        the square of the mesh size.
+    """
+    V, F = _check_positions(V, F)
     n = V.shape[-2]
     m = len(F)
     c = _face_cross(V, F)  # (..., m, 3)
@@ -323,10 +344,7 @@ def vertex_normals(V, F) -> np.ndarray:
         (np.ones(3 * m), (F.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m)
     )
     if V.ndim == 2:
-        acc = inc @ c
-    else:
-        N = V.shape[0]
-        acc = (inc @ c.transpose(1, 0, 2).reshape(m, N * 3)).reshape(n, N, 3).transpose(1, 0, 2)
-    acc = np.asarray(acc)
-    norm = np.linalg.norm(acc, axis=-1, keepdims=True)
-    return np.divide(acc, norm, out=np.zeros_like(acc), where=norm > 0)
+        return np.asarray(inc @ c)
+    N = V.shape[0]
+    acc = (inc @ c.transpose(1, 0, 2).reshape(m, N * 3)).reshape(n, N, 3).transpose(1, 0, 2)
+    return np.ascontiguousarray(acc)

@@ -1,0 +1,389 @@
+"""Meshes from RIMD features: the paper's way and an exact inverse.
+
+Both methods first recover the per-vertex rotations ``R_i`` from the edge rotations
+``dR_ij = R_i^T R_j``, then positions from ``T_i = R_i S_i``, and finally align the result rigidly
+to the reference (the feature carries no global pose).
+
+Rotation recovery (``rotations=``):
+
+- ``"bfs"``: the reference implementation's walk, ``R_j = R_parent dR_parent,j`` along a
+  breadth-first spanning tree (here rooted at a central vertex, so paths are as short as possible).
+  Exact for exact features, but noise accumulates along the tree paths.
+- ``"global"`` (default): the BFS result, then a few Gauss-Newton sweeps of a global least-squares
+  fit of all rotations to all edges: write ``R_i <- exp(hat(w_i)) R_i`` and solve
+  ``w_j - w_i = log(R_i dR_ij R_j^T)`` over every edge in the least-squares sense. That is a
+  graph-Laplacian system whose matrix depends only on the mesh, so it is factorised once and each
+  sweep costs one 3-column solve. For exact features the first sweep finds nothing to correct.
+
+Positions (``method=``):
+
+- ``"paper"``: minimise Eq. 1 over the deformed positions with ``T_i`` fixed,
+  ``sum_ij c_ij |e'_ij - T_i e_ij|^2``, a cotangent-Laplacian system ``L p' = b`` (factorised once),
+  optionally followed by the reference's local/global rounds (``iterations``): re-estimate each
+  ``R_i`` as the rotation agreeing best with the current positions and the neighbours'
+  ``R_j dR_ji``, then solve again. Not an exact inverse: per-vertex ``T_i`` are not integrable in
+  general.
+- ``"exact"`` (default): the feature extraction is inverted exactly. ``T_i`` is linear in the
+  deformed positions ``p'`` and the deformed normal edges ``m'`` (see
+  :mod:`meshvae_lib.deformation_gradient`): ``T_i = (K p')_i^T + m'_i h_i^T``. Taking both as
+  unknowns and minimising ``sum_i |T_i(p', m') - R_i S_i|_F^2``, the ``m'_i`` drop out in closed
+  form (projection orthogonal to ``h_i``), leaving one sparse symmetric system ``M p' = r`` in the
+  positions, the same matrix for the three coordinates and for every mesh. Exact features give the
+  mesh back to rounding error.
+
+One vertex per connected component is pinned (the feature has no translation); components are
+then placed by the final rigid alignment only, so several components keep their relative
+placement only up to a translation each.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+from scipy.sparse.linalg import splu
+
+from . import tolerances as tol
+from .alignment import rigid_align
+from .deformation_gradient import DeformationGradientOperator
+from .rimd import RIMDLayout
+from .rotations import _exp_soa, _log_soa, _polar_rs_soa, matmul_soa
+
+__all__ = ["METHODS", "ROTATION_RECOVERY", "RIMDReconstructor"]
+
+logger = logging.getLogger(__name__)
+
+METHODS = ("exact", "paper")
+ROTATION_RECOVERY = ("global", "bfs")
+#: permutation of the 9 SoA entries that transposes a 3x3 matrix.
+_TRANSPOSE = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
+
+
+def _factorize(M: sp.spmatrix):
+    return splu(sp.csc_matrix(M), permc_spec="MMD_AT_PLUS_A")
+
+
+def _central_roots(adj: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """One central vertex per connected component (middle of a pseudo-diameter path).
+
+    Returns ``(roots, labels)``: root ids and the component label of each vertex.
+    """
+    n_comp, labels = csgraph.connected_components(adj, directed=False)
+    roots = []
+    for c in range(n_comp):
+        start = int(np.flatnonzero(labels == c)[0])
+        d = csgraph.shortest_path(adj, indices=start, unweighted=True, directed=False)
+        a = int(np.argmax(np.where(np.isfinite(d), d, -1)))
+        d, pred = csgraph.shortest_path(adj, indices=a, unweighted=True, directed=False,
+                                        return_predecessors=True)
+        b = int(np.argmax(np.where(np.isfinite(d), d, -1)))
+        path = [b]
+        while path[-1] != a:
+            path.append(int(pred[path[-1]]))
+        roots.append(path[len(path) // 2])
+    return np.asarray(roots, np.int64), labels
+
+
+class RIMDReconstructor:
+    """Meshes from RIMD features, for one reference mesh; all factorisations happen here, once.
+
+    Parameters
+    ----------
+    V0 : (n_vertices, 3) float
+        The reference mesh the features were computed against.
+    F : (n_faces, 3) int
+    method : {"exact", "paper"}
+        Position solve, see the module docstring. ``"exact"`` (default) inverts the extraction;
+        ``"paper"`` minimises Eq. 1.
+    layout : {"paper", "compact"}
+        Feature layout (:class:`meshvae_lib.rimd.RIMDLayout`).
+    rotations : {"global", "bfs"}
+        Rotation recovery, see the module docstring. ``"global"`` (default) is robust to noise.
+    iterations : int, optional
+        ``method="paper"`` only: local/global refinement rounds after the first solve (the
+        reference does 10; default 10).
+
+    Attributes
+    ----------
+    layout : RIMDLayout
+    operator : DeformationGradientOperator
+    roots : (n_components,) int64
+        Root vertex of the rotation walk and pinned vertex, one per connected component.
+    """
+
+    def __init__(self, V0, F, method: str = "exact", layout: str = "paper",
+                 rotations: str = "global", iterations: int | None = None):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        if rotations not in ROTATION_RECOVERY:
+            raise ValueError(f"rotations must be one of {ROTATION_RECOVERY}, got {rotations!r}")
+        if iterations is not None and (int(iterations) != iterations or iterations < 0):
+            raise ValueError(f"iterations must be a non-negative integer, got {iterations!r}")
+        self.method = method
+        self.rotations = rotations
+        self.iterations = 10 if iterations is None else int(iterations)
+        op = DeformationGradientOperator(V0, F)
+        self.operator = op
+        self.V0 = np.asarray(V0, dtype=np.float64)
+        self.faces = op.faces
+        n = op.n_vertices
+        self.n_vertices = n
+        self.layout = RIMDLayout(op.faces, n, layout)
+        E = self.layout.edges
+        nE = len(E)
+        # --- graph, roots, BFS levels --------------------------------------------------------
+        adj = sp.csr_matrix((np.ones(nE), (E[:, 0], E[:, 1])), shape=(n, n))
+        adj = adj + adj.T
+        self.roots, self._component = _central_roots(adj)
+        depth = np.zeros(n)
+        parent = np.full(n, -1, np.int64)
+        for r in self.roots:
+            d, pred = csgraph.shortest_path(adj, indices=int(r), unweighted=True, directed=False,
+                                            return_predecessors=True)
+            mask = np.isfinite(d)
+            depth[mask] = d[mask]
+            parent[mask] = pred[mask]
+        parent[self.roots] = -1
+        depth = depth.astype(np.int64)
+        order = np.argsort(depth, kind="stable")
+        bounds = np.searchsorted(depth[order], np.arange(0, depth.max() + 2))
+        self._levels = [order[bounds[k]:bounds[k + 1]] for k in range(len(bounds) - 1)]
+        self._levels = [lv for lv in self._levels if len(lv)]
+        child = np.flatnonzero(parent >= 0)
+        self._parent = parent
+        from .topology import edge_index
+
+        self._parent_edge = np.zeros(n, np.int64)
+        self._parent_flip = np.zeros(n, bool)
+        self._parent_edge[child] = edge_index(E, parent[child], child)
+        self._parent_flip[child] = parent[child] > child  # dR_parent,child = dR_u^T
+        # --- rotation synchronisation: uniform graph Laplacian, factorised once ----------------
+        G = sp.csr_matrix(
+            (np.concatenate([-np.ones(nE), np.ones(nE)]),
+             (np.concatenate([np.arange(nE)] * 2), np.concatenate([E[:, 0], E[:, 1]]))),
+            shape=(nE, n),
+        )
+        self._Gt = G.T.tocsr()
+        pin = sp.csr_matrix((np.ones(len(self.roots)), (self.roots, self.roots)), shape=(n, n))
+        self._sync_lu = _factorize(G.T @ G + pin)
+        # --- position solve --------------------------------------------------------------------
+        if method == "exact":
+            h = op.h
+            hn2 = np.einsum("ij,ij->i", h, h)
+            P = np.tile(np.eye(3), (n, 1, 1))
+            nz = hn2 > 0
+            P[nz] -= h[nz, :, None] * h[nz, None, :] / hn2[nz, None, None]
+            Pm = _block_diag3(P)
+            PK = Pm @ op.K
+            M = (op.K.T @ PK).tocsr()
+            scale = float(M.diagonal().mean())
+            pin = sp.csr_matrix((np.full(len(self.roots), scale), (self.roots, self.roots)),
+                                shape=(n, n))
+            self._pos_lu = _factorize(M + pin)
+            self._rhs_op = PK.T.tocsr()  # (n, 3n)
+        else:
+            c = op.weights
+            W = sp.csr_matrix((c, (E[:, 0], E[:, 1])), shape=(n, n))
+            W = W + W.T
+            L = sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W
+            scale = float(L.diagonal().mean())
+            pin = sp.csr_matrix((np.full(len(self.roots), scale), (self.roots, self.roots)),
+                                shape=(n, n))
+            self._pos_lu = _factorize(L + pin)
+            # b_k[a] = sum_{j in N_k} c_kj / 2 (T_k + T_j)[a, :] e_kj, as Q @ Tcols
+            D = op.directed
+            cd = c[edge_index(E, D[:, 0], D[:, 1])]
+            e = self.V0[D[:, 0]] - self.V0[D[:, 1]]
+            val = 0.5 * cd[:, None] * e  # (2E, 3) coefficient of T[.][a, b] for b
+            rows = np.repeat(D[:, 0], 3)
+            cols_k = (3 * D[:, 0][:, None] + np.arange(3)).reshape(-1)
+            cols_j = (3 * D[:, 1][:, None] + np.arange(3)).reshape(-1)
+            self._rhs_op = sp.csr_matrix(
+                (np.concatenate([val.reshape(-1)] * 2),
+                 (np.concatenate([rows, rows]), np.concatenate([cols_k, cols_j]))),
+                shape=(n, 3 * n),
+            )
+            self._directed = D
+            self._directed_w = cd
+            self._directed_e = e
+            self._edge_norm = np.bincount(D[:, 0], weights=cd * np.einsum("dk,dk->d", e, e),
+                                          minlength=n)
+            self._degree = np.bincount(D[:, 0], minlength=n).astype(float)
+            self._directed_u = edge_index(E, D[:, 0], D[:, 1])
+            self._directed_flip = D[:, 0] > D[:, 1]
+
+    def __repr__(self) -> str:
+        return (f"RIMDReconstructor(method={self.method!r}, layout={self.layout.layout!r}, "
+                f"rotations={self.rotations!r}, n_vertices={self.n_vertices})")
+
+    # ------------------------------------------------------------------------------------------
+    # rotations
+
+    def _rotations_bfs(self, dR: np.ndarray) -> np.ndarray:
+        """Walk the spanning tree: ``R_child = R_parent dR_parent,child``. ``dR`` is (9, E).
+
+        One batched product per BFS level (the walk is sequential in depth only).
+        """
+        n = self.n_vertices
+        child = np.flatnonzero(self._parent >= 0)
+        d = dR[:, self._parent_edge]  # (9, n): dR of each vertex's tree edge
+        flip = self._parent_flip
+        d[:, flip] = d[_TRANSPOSE][:, flip]
+        dm = np.ascontiguousarray(d.T).reshape(n, 3, 3)
+        R = np.zeros((n, 3, 3))
+        R[self.roots] = np.eye(3)
+        del child
+        for lv in self._levels[1:]:
+            R[lv] = R[self._parent[lv]] @ dm[lv]
+        return np.ascontiguousarray(R.reshape(n, 9).T)
+
+    def _rotations_sync(self, R: np.ndarray, dR: np.ndarray) -> tuple[np.ndarray, int]:
+        """Global Gauss-Newton sweeps on all edges; returns (R, sweeps solved).
+
+        The residual of edge (i, j) is the axial vector of ``D = R_i dR_ij R_j^T`` (``sin`` of the
+        angle times the axis, equal to ``log D`` to third order, exactly zero when consistent).
+        """
+        E = self.layout.edges
+        sweeps = 0
+        for sweeps in range(tol.ROTATION_SYNC_MAX_SWEEPS + 1):
+            X = matmul_soa(R[:, E[:, 0]], dR)  # R_i dR_ij
+            Rj = R[:, E[:, 1]]
+            # axial part of D = X Rj^T: D[a, b] = sum_c X[a, c] Rj[b, c]
+            delta = np.empty((3, len(E)))
+            for k, (a, b) in enumerate(((2, 1), (0, 2), (1, 0))):
+                acc = X[3 * a] * Rj[3 * b] - X[3 * b] * Rj[3 * a]
+                acc += X[3 * a + 1] * Rj[3 * b + 1] - X[3 * b + 1] * Rj[3 * a + 1]
+                acc += X[3 * a + 2] * Rj[3 * b + 2] - X[3 * b + 2] * Rj[3 * a + 2]
+                delta[k] = 0.5 * acc
+            if sweeps == tol.ROTATION_SYNC_MAX_SWEEPS or (
+                    np.max(np.abs(delta)) < tol.ROTATION_SYNC_TOL):
+                break
+            w = self._sync_lu.solve(np.ascontiguousarray(self._Gt @ delta.T))  # (n, 3)
+            R = matmul_soa(_exp_soa(np.ascontiguousarray(w.T)), R)
+            if np.max(np.abs(w)) < tol.ROTATION_SYNC_STEP_TOL:
+                sweeps += 1
+                break
+        return R, sweeps
+
+    def recover_rotations(self, log_dR) -> np.ndarray:
+        """Per-vertex rotations from edge rotation vectors, up to one global rotation.
+
+        Parameters
+        ----------
+        log_dR : (n_edges, 3) float
+            ``log dR_ij`` of each undirected edge ``(i, j)``, ``i < j`` (``layout.edges`` order).
+
+        Returns
+        -------
+        R : (n_vertices, 3, 3) float64
+            ``R[root] = I`` for the BFS walk; the global sweeps keep the roots fixed.
+        """
+        log_dR = np.asarray(log_dR, dtype=np.float64)
+        if log_dR.shape != (self.layout.n_edges, 3):
+            raise ValueError(f"log_dR must have shape ({self.layout.n_edges}, 3), got {log_dR.shape}")
+        r = self._recover(np.ascontiguousarray(log_dR.T))
+        return np.ascontiguousarray(r.T).reshape(-1, 3, 3)
+
+    def _recover(self, w: np.ndarray) -> np.ndarray:
+        dR = _exp_soa(w)
+        R = self._rotations_bfs(dR)
+        if self.rotations == "global":
+            R, sweeps = self._rotations_sync(R, dR)
+            logger.debug("rotation sync: %d sweeps", sweeps)
+        return R
+
+    # ------------------------------------------------------------------------------------------
+    # positions
+
+    @staticmethod
+    def _tcols(T: np.ndarray) -> np.ndarray:
+        """(9, n) SoA gradients to (3n, 3) with ``[3 i + b, a] = T_i[a, b]``."""
+        n = T.shape[1]
+        return np.ascontiguousarray(T.reshape(3, 3, n).transpose(2, 1, 0)).reshape(3 * n, 3)
+
+    def _solve_positions(self, T: np.ndarray) -> np.ndarray:
+        return self._pos_lu.solve(np.ascontiguousarray(self._rhs_op @ self._tcols(T)))
+
+    def _local_step(self, P: np.ndarray, S: np.ndarray, R: np.ndarray, dR: np.ndarray
+                    ) -> np.ndarray:
+        """Reference-style local step: best rotation per vertex for positions and neighbours."""
+        n = self.n_vertices
+        D = self._directed
+        ep = P[D[:, 0]] - P[D[:, 1]]  # (2E, 3) e'_ij
+        Se = np.einsum("dab,db->da",
+                       np.ascontiguousarray(S.T).reshape(n, 3, 3)[D[:, 0]], self._directed_e)
+        w = self._directed_w
+        C = np.zeros((9, n))
+        for a in range(3):
+            for b in range(3):
+                C[3 * a + b] = np.bincount(D[:, 0], weights=w * ep[:, a] * Se[:, b], minlength=n)
+        C /= self._edge_norm
+        # neighbours' votes: R_i ~ R_j dR_ji, dR_ji = dR_u^T when i < j else dR_u
+        u = self._directed_u
+        d = dR[:, u]
+        notflip = ~self._directed_flip  # i < j: need dR_u^T
+        d[:, notflip] = d[_TRANSPOSE][:, notflip]
+        votes = matmul_soa(R[:, D[:, 1]], d)
+        for k in range(9):
+            C[k] += np.bincount(D[:, 0], weights=votes[k], minlength=n) / self._degree
+        Rn, _ = _polar_rs_soa(C)
+        return Rn
+
+    def _reconstruct_one(self, w: np.ndarray, S: np.ndarray) -> np.ndarray:
+        """``w`` (3, E) undirected log dR, ``S`` (9, n) -> positions (n, 3), not yet aligned."""
+        R = self._recover(w)
+        T = matmul_soa(R, S)
+        P = self._solve_positions(T)
+        if self.method == "paper" and self.iterations:
+            dR = _exp_soa(w)
+            for _ in range(self.iterations):
+                R = self._local_step(P, S, R, dR)
+                P = self._solve_positions(matmul_soa(R, S))
+        return P
+
+    def reconstruct(self, features, align: bool = True, progress: bool = False) -> np.ndarray:
+        """Mesh(es) from RIMD feature(s).
+
+        Parameters
+        ----------
+        features : (K,) or (n_meshes, K) float
+            In this reconstructor's layout (``self.layout.K`` numbers per mesh).
+        align : bool
+            Align each result rigidly (Kabsch, no scale) to the reference ``V0`` (default).
+        progress : bool
+            Show a progress bar (stderr).
+
+        Returns
+        -------
+        V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float64
+        """
+        f = self.layout._check_features(features)
+        if not np.all(np.isfinite(f)):
+            raise ValueError("features hold NaN or infinite values")
+        single = f.ndim == 1
+        f = f.reshape(-1, self.layout.K)
+        N, n = f.shape[0], self.n_vertices
+        out = np.empty((N, n, 3))
+        it = range(N)
+        if progress:
+            from tqdm.auto import tqdm
+
+            it = tqdm(it, desc="reconstructing", unit="mesh")
+        for k in it:
+            log_dR, S = self.layout.unpack(f[k])
+            w = np.ascontiguousarray(log_dR[0].T)
+            Ssoa = np.ascontiguousarray(S[0].reshape(n, 9).T)
+            out[k] = self._reconstruct_one(w, Ssoa)
+        if align:
+            out = rigid_align(out, self.V0)
+        return out[0] if single else out
+
+
+def _block_diag3(P: np.ndarray) -> sp.csr_matrix:
+    """Block-diagonal sparse matrix from ``(n, 3, 3)`` blocks."""
+    n = P.shape[0]
+    rows = (3 * np.arange(n)[:, None, None] + np.arange(3)[None, :, None]).repeat(3, axis=2)
+    cols = (3 * np.arange(n)[:, None, None] + np.arange(3)[None, None, :]).repeat(3, axis=1)
+    return sp.csr_matrix((P.reshape(-1), (rows.reshape(-1), cols.reshape(-1))), shape=(3 * n, 3 * n))
