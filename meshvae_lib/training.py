@@ -19,7 +19,7 @@ import numpy as np
 import torch
 
 from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, DEFAULT_LR
-from .vae import MeshVAE, vae_loss
+from .vae import MeshVAE, start_step, vae_loss
 
 __all__ = ["TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object"]
 
@@ -228,7 +228,7 @@ def train_vae(
             cb = None if c is None else c[idx]
             x_hat, mu, sigma = model(xb, cb, generator=noise_gen)
             parts = vae_loss(x_hat, xb, mu, sigma, config.alpha, so_t)
-            optimizer.zero_grad(set_to_none=True)
+            start_step(model)  # zero the gradients, keeping the big buffers (see vae.Linear)
             parts["total"].backward()
             optimizer.step()
             w = len(idx) / n

@@ -31,11 +31,72 @@ from torch import nn
 
 from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
 
-__all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
+__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear"]
+
+
+class _LinearGradInPlace(torch.autograd.Function):
+    """y = x W^T + b whose backward adds dL/dW into the existing ``W.grad`` buffer.
+
+    For K ~ 165k the weight gradients are 85-170 MB each. Letting autograd allocate them afresh at
+    every step costs more than the matrix products themselves (fresh pages from the OS: measured
+    130 ms against 35 ms for the same product into a kept buffer, 2 CPU threads). Keeping
+    ``W.grad`` allocated (``optimizer.zero_grad(set_to_none=False)``, as :func:`train_vae` does) and
+    accumulating into it with ``addmm_`` avoids that; the gradient is the same.
+    """
+
+    @staticmethod
+    def forward(ctx, x, weight, bias):
+        ctx.save_for_backward(x, weight)
+        return torch.nn.functional.linear(x, weight, bias)
+
+    @staticmethod
+    def backward(ctx, grad_out):
+        x, weight = ctx.saved_tensors
+        grad_x = grad_out @ weight if ctx.needs_input_grad[0] else None
+        if ctx.needs_input_grad[1]:
+            if weight.grad is None:
+                weight.grad = torch.zeros_like(weight)
+                weight._overwrite_grad = False
+            if getattr(weight, "_overwrite_grad", False):  # set by start_step: a fresh step
+                torch.mm(grad_out.t(), x, out=weight.grad)
+                weight._overwrite_grad = False
+            else:
+                weight.grad.addmm_(grad_out.t(), x)
+        grad_b = grad_out.sum(0) if ctx.needs_input_grad[2] else None
+        return grad_x, None, grad_b
+
+
+class Linear(nn.Linear):
+    """``nn.Linear`` whose weight gradient accumulates in place (see :class:`_LinearGradInPlace`).
+
+    Same parameters, same state dict, same values and gradients as ``nn.Linear``.
+    """
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        if torch.is_grad_enabled() and self.weight.requires_grad and self.bias is not None:
+            return _LinearGradInPlace.apply(x, self.weight, self.bias)
+        return super().forward(x)
+
+
+def start_step(module: nn.Module) -> None:
+    """Reset gradients before a training step, keeping the big weight-gradient buffers.
+
+    Equivalent to ``optimizer.zero_grad(set_to_none=False)`` but cheaper: the weight gradients of
+    this module's :class:`Linear` layers are not zeroed (170 MB of memset at K ~ 165k) but marked
+    to be overwritten, rather than accumulated into, by the next backward pass.
+    """
+    marked = set()
+    for m in module.modules():
+        if isinstance(m, Linear) and m.weight.grad is not None:
+            m.weight._overwrite_grad = True
+            marked.add(id(m.weight))
+    for p in module.parameters():
+        if p.grad is not None and id(p) not in marked:
+            p.grad.zero_()
 
 
 def _block(n_in: int, n_out: int, slope: float) -> list[nn.Module]:
-    return [nn.Linear(n_in, n_out), nn.BatchNorm1d(n_out), nn.LeakyReLU(slope)]
+    return [Linear(n_in, n_out), nn.BatchNorm1d(n_out), nn.LeakyReLU(slope)]
 
 
 class MeshVAE(nn.Module):
@@ -92,7 +153,7 @@ class MeshVAE(nn.Module):
             width = h
         self.encoder_body = nn.Sequential(*layers)
         # one matrix for both heads: a single (cheaper) matmul over the K inputs
-        self.encoder_head = nn.Linear(width, 2 * self.latent_dim)
+        self.encoder_head = Linear(width, 2 * self.latent_dim)
 
         layers = []
         width = self.latent_dim + self.n_conditions
@@ -100,7 +161,7 @@ class MeshVAE(nn.Module):
             layers += _block(width, h, negative_slope)
             width = h
         self.decoder_body = nn.Sequential(*layers)
-        self.decoder_head = nn.Linear(width, self.n_features)
+        self.decoder_head = Linear(width, self.n_features)
 
     # -- configuration -------------------------------------------------------------------------
     def config(self) -> dict:
@@ -208,7 +269,7 @@ def vae_loss(
     """
     if x_hat.shape != x.shape or x.ndim != 2:
         raise ValueError(f"x_hat and x must be (M, K) of the same shape, got {tuple(x_hat.shape)} and {tuple(x.shape)}")
-    mse = torch.mean((x_hat - x) ** 2)
+    mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
     reconstruction = 0.5 * alpha * mse
     kl = torch.mean(kl_divergence(mu, sigma, sigma_object))
     return {"total": reconstruction + kl, "reconstruction": reconstruction, "kl": kl, "mse": mse.detach()}
