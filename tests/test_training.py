@@ -1,0 +1,99 @@
+"""train_vae: loss goes down, runs repeat exactly, history and held-out parts, sigma_object."""
+
+import numpy as np
+import pytest
+import torch
+
+from meshvae_lib.normalization import FeatureNormalizer
+from meshvae_lib.training import TrainConfig, holdout_mask, pad_sigma_object, resolve_device, train_vae
+
+torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
+
+
+def _data(n=48, k=60, seed=0):
+    """Normalised rows that lie near a 3-D manifold (so a small latent space can explain them)."""
+    rng = np.random.default_rng(seed)
+    Z = rng.normal(size=(n, 3))
+    X = np.tanh(Z @ rng.normal(size=(3, k)) / 2) + 0.01 * rng.normal(size=(n, k))
+    return FeatureNormalizer().fit_transform(X)
+
+
+def test_tiny_training_run_lowers_the_loss_and_records_history():
+    X = _data()
+    res = train_vae(X[:40], config=TrainConfig(epochs=60, latent_dim=6, batch_size=8, progress=False, eval_every=20),
+                    val_features=X[40:])
+    h = res.history
+    assert len(h) == 60 and [r["epoch"] for r in h] == list(range(1, 61))
+    assert h[-1]["total"] < 0.2 * h[0]["total"]
+    assert h[-1]["mse"] < 0.3 * h[0]["mse"]
+    for r in h:
+        assert r["total"] == pytest.approx(r["reconstruction"] + r["kl"], rel=1e-5)
+    evaluated = [r["epoch"] for r in h if "val_mse" in r]
+    assert evaluated == [20, 40, 60]
+    assert h[-1]["val_mse"] < h[0]["mse"]
+    assert not res.model.training and res.seconds > 0 and res.device == "cpu"
+
+
+def test_same_seed_gives_identical_weights_other_seed_does_not():
+    X = _data(n=20, k=30)
+    cfg = dict(epochs=4, latent_dim=4, hidden=(8,), progress=False)
+    a = train_vae(X, config=TrainConfig(seed=3, **cfg)).model.state_dict()
+    b = train_vae(X, config=TrainConfig(seed=3, **cfg)).model.state_dict()
+    c = train_vae(X, config=TrainConfig(seed=4, **cfg)).model.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    assert not all(torch.equal(a[k], c[k]) for k in a)
+
+
+def test_sigma_object_shrinks_the_spread_of_the_chosen_dimensions():
+    X = _data(n=40, k=40, seed=1)
+    latent = 6
+
+    def spread(sigma_object):
+        # a small alpha and a large lr let the KL term act within a few hundred steps
+        res = train_vae(X, config=TrainConfig(epochs=100, batch_size=8, alpha=200.0, latent_dim=latent,
+                                              sigma_object=sigma_object, lr=1e-2, progress=False, seed=0))
+        with torch.no_grad():
+            mu, sigma = res.model.encode(torch.from_numpy(X.astype(np.float32)))
+        # std of the aggregate posterior per dimension: sqrt(var of means + mean variance)
+        return np.sqrt(mu.var(0).numpy() + (sigma**2).mean(0).numpy())
+
+    base = spread(None)
+    small = spread((0.1, 0.1))  # padded with 1 to the latent size
+    assert np.all(small[:2] < 0.25), small
+    assert np.all(small[:2] < 0.35 * base[:2]), (small, base)
+    assert np.all(small[2:] > 0.5), small
+
+
+def test_holdout_mask_and_sigma_object_padding():
+    np.testing.assert_array_equal(np.flatnonzero(holdout_mask(10, 3)), [2, 5, 8])
+    assert not holdout_mask(5, 0).any()
+    with pytest.raises(ValueError, match="got 1"):
+        holdout_mask(5, 1)
+    np.testing.assert_array_equal(pad_sigma_object([0.1, 0.5], 4), [0.1, 0.5, 1.0, 1.0])
+    assert pad_sigma_object(None, 4) is None
+    with pytest.raises(ValueError, match="3 entries.*2"):
+        pad_sigma_object([1, 1, 1], 2)
+    with pytest.raises(ValueError, match="positive"):
+        pad_sigma_object([0.0], 2)
+
+
+def test_conditional_training_and_input_checks():
+    X = _data(n=12, k=20)
+    C = np.eye(2)[np.arange(12) % 2]
+    res = train_vae(X, C, TrainConfig(epochs=2, latent_dim=3, progress=False), X[:4], C[:4])
+    assert res.model.n_conditions == 2
+    with pytest.raises(ValueError, match="val_conditions"):
+        train_vae(X, C, TrainConfig(epochs=1, progress=False), X[:4])
+    with pytest.raises(ValueError, match="at least 2"):
+        train_vae(X[:1], config=TrainConfig(epochs=1, progress=False))
+    with pytest.raises(ValueError, match="conditions has 3 rows"):
+        train_vae(X, C[:3], TrainConfig(epochs=1, progress=False))
+    with pytest.raises(ValueError, match="epochs"):
+        TrainConfig(epochs=0)
+    assert resolve_device("cpu").type == "cpu"
+
+
+def test_progress_bar_is_shown_when_asked(capsys):
+    X = _data(n=8, k=10)
+    train_vae(X, config=TrainConfig(epochs=2, latent_dim=2, progress=True))
+    assert "training mesh VAE" in capsys.readouterr().err
