@@ -87,6 +87,7 @@ class FeatureExtractor:
         self.reference_ = np.array(V0, dtype=np.float64)
         self.faces_ = np.array(F, dtype=np.int64)
         self._reconstructor = None
+        self._encoder = None
         if self.kind == "rimd":
             from .rimd import RIMDLayout
 
@@ -117,10 +118,11 @@ class FeatureExtractor:
         V, F = _unpack(vertices)
         self.check_compatible(V, F)
         if self.kind == "rimd":
-            from .rimd import rimd_features
+            if getattr(self, "_encoder", None) is None:
+                from .rimd import RIMDEncoder
 
-            X = rimd_features(self.reference_, V, self.faces_, layout=self.layout)
-            X = np.asarray(X, dtype=np.float64).reshape(len(V), -1)
+                self._encoder = RIMDEncoder(self.reference_, self.faces_, layout=self.layout)
+            X = np.asarray(self._encoder.transform(V), dtype=np.float64).reshape(len(V), -1)
         elif self.kind == "aligned":
             X = rigid_align(V, self.reference_).reshape(len(V), -1)
         else:
@@ -178,7 +180,7 @@ class FeatureExtractor:
             raise ValueError(f"invalid feature extractor state: kind {ext.kind!r}, reference {V0.shape}, faces {F.shape}")
         if ext.kind == "rimd":
             # the feature length is known without building the layout (which needs the geometry code)
-            ext.reference_, ext.faces_, ext._reconstructor = V0, F, None
+            ext.reference_, ext.faces_, ext._reconstructor, ext._encoder = V0, F, None, None
             ext.n_features_ = int(state["n_features"])
             return ext
         ext._set_reference(V0, F)
