@@ -99,4 +99,19 @@ BCE_TARGET_RANGE = (0.1, 0.9)
 #: exact reconstruction: weight of the paper's Eq. 1 energy added to the exact least-squares
 #: system, relative to the mean diagonals. It only decides the rare position modes the exact system
 #: cannot see (on perfectly symmetric one-rings); its bias on exact features is far below 1e-8.
-EXACT_REGULARIZATION = 1e-6
+EXACT_REGULARIZATION = 1e-10
+#: exact reconstruction: Gauss-Newton steps stop when no vertex moves more than this fraction of
+#: the reference's bounding-box diagonal, or after EXACT_REFINE_MAX_STEPS steps.
+EXACT_REFINE_TOL = 1e-9
+EXACT_REFINE_MAX_STEPS = 3
+#: exact reconstruction: no Gauss-Newton step when every entry of T_i(p') - T_i is below this
+#: fraction of the largest |T| entry (exact features on generic meshes need none).
+EXACT_RESIDUAL_TOL = 1e-10
+
+# --- mesh VAE training defaults (measured: docs/vae.md) --------------------------------------
+#: training epochs when none are given (enough for 50-200 meshes at batch 32).
+DEFAULT_EPOCHS = 1000
+#: meshes per Adam step.
+DEFAULT_BATCH_SIZE = 32
+#: internal layer sizes for the coordinate baselines of Table 3 (RIMD uses none).
+HIDDEN_COORDS = (512,)
