@@ -19,17 +19,23 @@ Positions (``method=``):
 
 - ``"paper"``: minimise Eq. 1 over the deformed positions with ``T_i`` fixed,
   ``sum_ij c_ij |e'_ij - T_i e_ij|^2``, a cotangent-Laplacian system ``L p' = b`` (factorised once),
-  optionally followed by the reference's local/global rounds (``iterations``): re-estimate each
-  ``R_i`` as the rotation agreeing best with the current positions and the neighbours'
-  ``R_j dR_ji``, then solve again. Not an exact inverse: per-vertex ``T_i`` are not integrable in
-  general.
+  optionally followed by the reference's local/global rounds (``iterations``, off by default):
+  re-estimate each ``R_i`` as the rotation agreeing best with the current positions (normalised
+  ``sum_j c_ij e'_ij (S_i e_ij)^T``) and the neighbours' ``R_j dR_ji`` (averaged), then solve
+  again. Not an exact inverse: per-vertex ``T_i`` are not integrable in general.
 - ``"exact"`` (default): the feature extraction is inverted exactly. ``T_i`` is linear in the
   deformed positions ``p'`` and the deformed normal edges ``m'`` (see
   :mod:`meshvae_lib.deformation_gradient`): ``T_i = (K p')_i^T + m'_i h_i^T``. Taking both as
   unknowns and minimising ``sum_i |T_i(p', m') - R_i S_i|_F^2``, the ``m'_i`` drop out in closed
   form (projection orthogonal to ``h_i``), leaving one sparse symmetric system ``M p' = r`` in the
-  positions, the same matrix for the three coordinates and for every mesh. Exact features give the
-  mesh back to rounding error.
+  positions, the same matrix for the three coordinates and for every mesh. On generic meshes exact
+  features give the mesh back to rounding error. Where one-rings are perfectly symmetric (regular
+  procedural meshes) ``M`` has extra null modes (fields whose one-ring fit changes only along
+  ``h_i``, which free ``m'`` absorbs); a tiny multiple of the paper's Eq. 1 system
+  (``EXACT_REGULARIZATION``) decides them, and up to ``EXACT_REFINE_MAX_STEPS`` Gauss-Newton
+  steps on ``sum_i |T_i(p') - R_i S_i|^2`` with the true ``m'(p')`` (matrix ``K^T K``, also
+  factorised once) remove what is left. A step is taken only when the residual is above
+  ``EXACT_RESIDUAL_TOL``.
 
 One vertex per connected component is pinned (the feature has no translation); components are
 then placed by the final rigid alignment only, so several components keep their relative
@@ -49,7 +55,8 @@ from . import tolerances as tol
 from .alignment import rigid_align
 from .deformation_gradient import DeformationGradientOperator
 from .rimd import RIMDLayout
-from .rotations import _exp_soa, _log_soa, _polar_rs_soa, matmul_soa
+from .rotations import _exp_soa, _polar_rs_soa, matmul_soa
+from .topology import edge_index
 
 __all__ = ["METHODS", "ROTATION_RECOVERY", "RIMDReconstructor"]
 
@@ -103,7 +110,12 @@ class RIMDReconstructor:
         Rotation recovery, see the module docstring. ``"global"`` (default) is robust to noise.
     iterations : int, optional
         ``method="paper"`` only: local/global refinement rounds after the first solve (the
-        reference does 10; default 10).
+        reference does 10). Default 0: in our measurements (docs/geometry.md) the rounds move the
+        result away from the true mesh, with exact or noisy features alike.
+    refine : bool
+        ``method="exact"`` only: Gauss-Newton steps after the linear solve (default, see the module
+        docstring). Without them, meshes with perfectly symmetric one-rings (procedural meshes)
+        keep errors around 1e-5 of the diagonal.
 
     Attributes
     ----------
@@ -114,7 +126,7 @@ class RIMDReconstructor:
     """
 
     def __init__(self, V0, F, method: str = "exact", layout: str = "paper",
-                 rotations: str = "global", iterations: int | None = None):
+                 rotations: str = "global", iterations: int | None = None, refine: bool = True):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if rotations not in ROTATION_RECOVERY:
@@ -122,8 +134,9 @@ class RIMDReconstructor:
         if iterations is not None and (int(iterations) != iterations or iterations < 0):
             raise ValueError(f"iterations must be a non-negative integer, got {iterations!r}")
         self.method = method
+        self.refine = bool(refine)
         self.rotations = rotations
-        self.iterations = 10 if iterations is None else int(iterations)
+        self.iterations = 0 if iterations is None else int(iterations)
         op = DeformationGradientOperator(V0, F)
         self.operator = op
         self.V0 = np.asarray(V0, dtype=np.float64)
@@ -153,8 +166,6 @@ class RIMDReconstructor:
         self._levels = [lv for lv in self._levels if len(lv)]
         child = np.flatnonzero(parent >= 0)
         self._parent = parent
-        from .topology import edge_index
-
         self._parent_edge = np.zeros(n, np.int64)
         self._parent_flip = np.zeros(n, bool)
         self._parent_edge[child] = edge_index(E, parent[child], child)
@@ -169,42 +180,53 @@ class RIMDReconstructor:
         pin = sp.csr_matrix((np.ones(len(self.roots)), (self.roots, self.roots)), shape=(n, n))
         self._sync_lu = _factorize(G.T @ G + pin)
         # --- position solve --------------------------------------------------------------------
+        # the paper's Eq. 1 normal equations L p' = Q t (cotangent Laplacian); "exact" uses them
+        # as a tiny regulariser (see the class docstring), "paper" solves them.
+        c = op.weights
+        W = sp.csr_matrix((c, (E[:, 0], E[:, 1])), shape=(n, n))
+        W = W + W.T
+        L = (sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
+        D = op.directed
+        cd = c[edge_index(E, D[:, 0], D[:, 1])]
+        e = self.V0[D[:, 0]] - self.V0[D[:, 1]]
+        # b_k[a] = sum_{j in N_k} c_kj / 2 (T_k + T_j)[a, :] e_kj, as Q @ Tcols
+        val = 0.5 * cd[:, None] * e
+        rows = np.repeat(D[:, 0], 3)
+        cols_k = (3 * D[:, 0][:, None] + np.arange(3)).reshape(-1)
+        cols_j = (3 * D[:, 1][:, None] + np.arange(3)).reshape(-1)
+        Q = sp.csr_matrix(
+            (np.concatenate([val.reshape(-1)] * 2),
+             (np.concatenate([rows, rows]), np.concatenate([cols_k, cols_j]))),
+            shape=(n, 3 * n),
+        )
         if method == "exact":
             h = op.h
             hn2 = np.einsum("ij,ij->i", h, h)
             P = np.tile(np.eye(3), (n, 1, 1))
             nz = hn2 > 0
             P[nz] -= h[nz, :, None] * h[nz, None, :] / hn2[nz, None, None]
-            Pm = _block_diag3(P)
-            PK = Pm @ op.K
+            PK = _block_diag3(P) @ op.K
             M = (op.K.T @ PK).tocsr()
-            scale = float(M.diagonal().mean())
-            pin = sp.csr_matrix((np.full(len(self.roots), scale), (self.roots, self.roots)),
-                                shape=(n, n))
-            self._pos_lu = _factorize(M + pin)
-            self._rhs_op = PK.T.tocsr()  # (n, 3n)
+            lam = tol.EXACT_REGULARIZATION * float(M.diagonal().mean() / L.diagonal().mean())
+            self.regularization_ = lam
+            A = M + lam * L
+            rhs = (PK.T + lam * Q).tocsr()
+            # Gauss-Newton refinement with the true normal edges m'(p'): matrix K^T K, once
+            KtK = (op.K.T @ op.K).tocsr()
+            pin = sp.csr_matrix(
+                (np.full(len(self.roots), float(KtK.diagonal().mean())), (self.roots, self.roots)),
+                shape=(n, n))
+            self._gn_lu = _factorize(KtK + pin)
+            self._Kt = op.K.T.tocsr()
+            self._diag = float(np.linalg.norm(self.V0.max(0) - self.V0.min(0)))
         else:
-            c = op.weights
-            W = sp.csr_matrix((c, (E[:, 0], E[:, 1])), shape=(n, n))
-            W = W + W.T
-            L = sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W
-            scale = float(L.diagonal().mean())
-            pin = sp.csr_matrix((np.full(len(self.roots), scale), (self.roots, self.roots)),
-                                shape=(n, n))
-            self._pos_lu = _factorize(L + pin)
-            # b_k[a] = sum_{j in N_k} c_kj / 2 (T_k + T_j)[a, :] e_kj, as Q @ Tcols
-            D = op.directed
-            cd = c[edge_index(E, D[:, 0], D[:, 1])]
-            e = self.V0[D[:, 0]] - self.V0[D[:, 1]]
-            val = 0.5 * cd[:, None] * e  # (2E, 3) coefficient of T[.][a, b] for b
-            rows = np.repeat(D[:, 0], 3)
-            cols_k = (3 * D[:, 0][:, None] + np.arange(3)).reshape(-1)
-            cols_j = (3 * D[:, 1][:, None] + np.arange(3)).reshape(-1)
-            self._rhs_op = sp.csr_matrix(
-                (np.concatenate([val.reshape(-1)] * 2),
-                 (np.concatenate([rows, rows]), np.concatenate([cols_k, cols_j]))),
-                shape=(n, 3 * n),
-            )
+            A, rhs = L, Q
+        scale = float(A.diagonal().mean())
+        pin = sp.csr_matrix((np.full(len(self.roots), scale), (self.roots, self.roots)),
+                            shape=(n, n))
+        self._pos_lu = _factorize(A + pin)
+        self._rhs_op = rhs  # (n, 3n)
+        if method == "paper":
             self._directed = D
             self._directed_w = cd
             self._directed_e = e
@@ -331,11 +353,35 @@ class RIMDReconstructor:
         Rn, _ = _polar_rs_soa(C)
         return Rn
 
+    def _refine_exact(self, P: np.ndarray, tcols: np.ndarray) -> tuple[np.ndarray, int]:
+        """Gauss-Newton on ``sum_i |T_i(p') - T_i|^2`` with the true ``m'(p')``; (P, steps)."""
+        op = self.operator
+        n = self.n_vertices
+        steps = 0
+        tscale = max(float(np.max(np.abs(tcols))), 1e-300)
+        for steps in range(1, tol.EXACT_REFINE_MAX_STEPS + 1):
+            m = op.deformed_normal_edges(P[None])[0]  # (n, 3)
+            res = op.K @ P
+            res += (op.h[:, :, None] * m[:, None, :]).reshape(3 * n, 3)
+            res -= tcols
+            if np.max(np.abs(res)) < tol.EXACT_RESIDUAL_TOL * tscale:
+                steps -= 1
+                break
+            dP = self._gn_lu.solve(np.ascontiguousarray(self._Kt @ res))
+            P = P - dP
+            if np.max(np.abs(dP)) < tol.EXACT_REFINE_TOL * self._diag:
+                break
+        return P, steps
+
     def _reconstruct_one(self, w: np.ndarray, S: np.ndarray) -> np.ndarray:
         """``w`` (3, E) undirected log dR, ``S`` (9, n) -> positions (n, 3), not yet aligned."""
         R = self._recover(w)
         T = matmul_soa(R, S)
-        P = self._solve_positions(T)
+        tcols = self._tcols(T)
+        P = self._pos_lu.solve(np.ascontiguousarray(self._rhs_op @ tcols))
+        if self.method == "exact" and self.refine:
+            P, steps = self._refine_exact(P, tcols)
+            logger.debug("exact reconstruction: %d Gauss-Newton steps", steps)
         if self.method == "paper" and self.iterations:
             dR = _exp_soa(w)
             for _ in range(self.iterations):
