@@ -18,12 +18,25 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import torch
 
-from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, DEFAULT_LR
+from .tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, HIDDEN_COORDS
 from .vae import MeshVAE, start_step, vae_loss
 
-__all__ = ["TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object"]
+__all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object"]
 
 logger = logging.getLogger(__name__)
+
+
+def default_hidden(kind: str = "rimd") -> tuple[int, ...]:
+    """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
+
+    RIMD: none (the paper's features are already nearly linear in the latent factors; a hidden
+    layer costs about 5x per step at K ~ 165k). Coordinate baselines: HIDDEN_COORDS.
+    """
+    if kind == "rimd":
+        return ()
+    if kind in ("coords", "aligned"):
+        return tuple(HIDDEN_COORDS)
+    raise ValueError(f"unknown feature kind {kind!r}")
 
 
 @dataclass
@@ -45,8 +58,8 @@ class TrainConfig:
     eval_every : evaluate the held-out rows every this many epochs (and at the last epoch).
     """
 
-    epochs: int = 300
-    batch_size: int = 32
+    epochs: int = DEFAULT_EPOCHS
+    batch_size: int = DEFAULT_BATCH_SIZE
     lr: float = DEFAULT_LR
     alpha: float = DEFAULT_ALPHA
     latent_dim: int = DEFAULT_LATENT
