@@ -1,0 +1,331 @@
+"""Shaded matplotlib renderings of triangle meshes: static figures, the README, and the fallback.
+
+A small software renderer: an orthographic view from ``(elev, azim)``, Lambert shading of the
+face normals (:func:`meshvae_lib.topology.face_normals`, two-sided, light from the upper left of
+the viewer), and the painter's algorithm (faces drawn far to near as one ``PolyCollection``). It
+uses a plain 2D axes, so it is fast (a 5k-face mesh renders in well under a second) and looks the
+same in every backend. Only ``matplotlib.figure`` and ``matplotlib.collections`` are imported;
+figures are created without pyplot, so nothing is left open in pyplot's figure manager.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+
+from ..topology import face_normals
+from .buffers import check_vertices, color_buffer
+from .colors import DEFAULT_MESH_COLOR, ColorMapping
+
+__all__ = ["view_basis", "project", "shade", "render_mesh", "render_mesh_grid", "figure_to_png"]
+
+#: default view (elevation, azimuth) in degrees: slightly from above and from the front-right.
+DEFAULT_VIEW = (15.0, 30.0)
+_UP_AXES = {"y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+def view_basis(view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
+    """Orthonormal camera frame for a view.
+
+    Parameters
+    ----------
+    view : (elev, azim) degrees
+        ``(0, 0)`` looks at the front (from +z towards the origin when ``up="y"``, from -y when
+        ``up="z"``); positive ``elev`` looks from above, positive ``azim`` turns the camera to the
+        right about the up axis.
+    up : {"y", "z"}
+        Which model axis points up on screen.
+
+    Returns
+    -------
+    R : (3, 3) float64
+        Rows: screen right, screen up, towards the viewer.
+    """
+    if up not in _UP_AXES:
+        raise ValueError(f"up must be 'y' or 'z', got {up!r}")
+    elev, azim = (math.radians(float(a)) for a in view)
+    if up == "y":
+        d = np.array([math.cos(elev) * math.sin(azim), math.sin(elev), math.cos(elev) * math.cos(azim)])
+    else:
+        d = np.array([math.cos(elev) * math.sin(azim), -math.cos(elev) * math.cos(azim), math.sin(elev)])
+    u = _UP_AXES[up]
+    right = np.cross(u, d)
+    if np.linalg.norm(right) < 1e-9:  # looking straight down the up axis
+        right = np.cross(np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, 1.0, 0.0]), d)
+    right /= np.linalg.norm(right)
+    true_up = np.cross(d, right)
+    return np.stack([right, true_up, d])
+
+
+def project(V, view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
+    """Vertices in camera coordinates.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) float
+
+    Returns
+    -------
+    P : (n_vertices, 3) float64
+        Columns: screen x, screen y, depth (larger is nearer the viewer).
+    """
+    return check_vertices(V) @ view_basis(view, up).T
+
+
+def shade(normals, basis, ambient: float = 0.35, diffuse: float = 0.65) -> np.ndarray:
+    """Two-sided Lambert intensity per face.
+
+    Parameters
+    ----------
+    normals : (n_faces, 3) float64
+        Unit face normals in model coordinates.
+    basis : (3, 3) float64
+        From :func:`view_basis`; the light comes from the viewer's upper left.
+    ambient, diffuse : float
+
+    Returns
+    -------
+    intensity : (n_faces,) float64 in [ambient, ambient + diffuse]
+    """
+    light = np.array([-0.35, 0.55, 1.0]) @ basis  # camera frame -> model frame
+    light /= np.linalg.norm(light)
+    return ambient + diffuse * np.abs(normals @ light)
+
+
+def _face_colors(colors, n_vertices: int, F: np.ndarray) -> np.ndarray:
+    """Base RGB per face: per-vertex colours are averaged over the face's corners."""
+    if colors is None:
+        colors = DEFAULT_MESH_COLOR
+    C = None if isinstance(colors, str) else np.asarray(colors, dtype=np.float64)
+    if C is not None and C.ndim == 2 and C.shape[0] == len(F) and C.shape[0] != n_vertices:
+        return np.array(color_buffer(C, len(F)), dtype=np.float64)  # already per face
+    Cv = color_buffer(colors, n_vertices).astype(np.float64)
+    return Cv[F].mean(axis=1)
+
+
+def render_mesh(
+    ax,
+    V,
+    F,
+    colors=None,
+    view=DEFAULT_VIEW,
+    up: str = "y",
+    ambient: float = 0.35,
+    edgecolor=None,
+    linewidth: float = 0.0,
+    cull_backfaces: bool = False,
+    extent=None,
+    center=None,
+):
+    """Draw one shaded mesh into a 2D matplotlib axes.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        A plain 2D axes; its limits are set to frame the mesh and its frame is hidden.
+    V : (n_vertices, 3) float
+    F : (n_faces, 3) int
+    colors : None, str, (3,), (n_vertices, 3) or (n_faces, 3) float in [0, 1]
+        Base colour(s) before shading (default a light blue-grey).
+    view : (elev, azim) degrees, see :func:`view_basis`.
+    up : {"y", "z"}
+    ambient : float
+        Intensity of faces lit edge-on; ``1 - ambient`` is added for faces facing the light.
+    edgecolor, linewidth
+        Passed to the collection (e.g. ``edgecolor="k", linewidth=0.1`` for a wireframe look).
+    cull_backfaces : bool
+        Skip faces pointing away from the viewer (only for closed, consistently oriented meshes).
+    extent : float, optional
+        Half size of the square frame, in model units (default: fits this mesh). Pass one value to
+        several axes to draw them at one scale.
+    center : (2,) float, optional
+        Screen-space centre of the frame (default: the centre of the mesh's projection).
+
+    Returns
+    -------
+    collection : matplotlib.collections.PolyCollection
+    """
+    from matplotlib.collections import PolyCollection
+
+    V = check_vertices(V)
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
+        raise ValueError(f"F must have shape (n_faces, 3) with n_faces > 0, got {F.shape}")
+    F = F.astype(np.int64)
+    if F.min() < 0 or F.max() >= len(V):
+        raise ValueError(f"F indexes vertices {F.min()}..{F.max()} but V has {len(V)} vertices")
+    R = view_basis(view, up)
+    P = V @ R.T
+    N = face_normals(V, F)
+    base = _face_colors(colors, len(V), F)
+    rgb = np.clip(base * shade(N, R, ambient=ambient, diffuse=1.0 - ambient)[:, None], 0.0, 1.0)
+    depth = P[F, 2].mean(axis=1)
+    keep = np.ones(len(F), dtype=bool)
+    if cull_backfaces:
+        keep = (N @ R[2]) > 0.0
+    order = np.argsort(depth[keep], kind="stable")
+    idx = np.flatnonzero(keep)[order]
+    polys = P[F[idx]][:, :, :2]
+    coll = PolyCollection(
+        polys,
+        facecolors=rgb[idx],
+        edgecolors=rgb[idx] if edgecolor is None else edgecolor,
+        linewidths=linewidth if edgecolor is not None else 0.3,
+        antialiaseds=True,
+    )
+    ax.add_collection(coll)
+    lo, hi = P[:, :2].min(axis=0), P[:, :2].max(axis=0)
+    c = 0.5 * (lo + hi) if center is None else np.asarray(center, dtype=np.float64)
+    e = 0.55 * float(np.max(hi - lo)) if extent is None else float(extent)
+    e = max(e, 1e-12)
+    ax.set_xlim(c[0] - e, c[0] + e)
+    ax.set_ylim(c[1] - e, c[1] + e)
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    return coll
+
+
+def _as_mesh_list(meshes) -> list[np.ndarray]:
+    if isinstance(meshes, np.ndarray) and meshes.ndim == 2:
+        meshes = [meshes]
+    if isinstance(meshes, np.ndarray) and meshes.ndim != 3:
+        raise ValueError(f"meshes must be (n_vertices, 3), (n_meshes, n_vertices, 3) or a list, got {meshes.shape}")
+    out = [check_vertices(V, f"meshes[{i}]") for i, V in enumerate(meshes)]
+    if not out:
+        raise ValueError("no meshes to render")
+    n = {len(V) for V in out}
+    if len(n) != 1:
+        raise ValueError(f"all meshes must share one connectivity; got vertex counts {sorted(n)}")
+    return out
+
+
+def _per_mesh(colors, k: int, n_vertices: int) -> list:
+    """Split ``colors`` into one entry per mesh (None, one shared colour, or one per mesh)."""
+    if colors is None or isinstance(colors, str):
+        return [colors] * k
+    if isinstance(colors, (list, tuple)) and len(colors) == k and not np.isscalar(colors[0]):
+        return list(colors)
+    C = np.asarray(colors, dtype=np.float64)
+    if C.ndim == 3:
+        if C.shape[0] != k:
+            raise ValueError(f"colors has {C.shape[0]} entries for {k} meshes")
+        return list(C)
+    return [C] * k
+
+
+def render_mesh_grid(
+    meshes,
+    F,
+    titles=None,
+    ncols: int = 4,
+    colors=None,
+    view=DEFAULT_VIEW,
+    up: str = "y",
+    size: float = 2.4,
+    same_scale: bool = True,
+    colorbar: ColorMapping | None = None,
+    legend=None,
+    suptitle: str | None = None,
+    dpi: int = 100,
+    **render_kw,
+):
+    """Several meshes of one connectivity in a grid of shaded renderings.
+
+    Parameters
+    ----------
+    meshes : (n_meshes, n_vertices, 3) float, a list of (n_vertices, 3), or one (n_vertices, 3)
+    F : (n_faces, 3) int
+    titles : sequence of str, optional
+        One title per mesh.
+    ncols : int
+        Columns of the grid (rows follow).
+    colors : None, a colour, (n_vertices, 3), (n_meshes, n_vertices, 3) or a list per mesh
+    view, up
+        See :func:`view_basis`.
+    size : float
+        Size of each panel in inches.
+    same_scale : bool
+        Draw every mesh at one scale (sizes compare); each panel is still centred on its mesh.
+    colorbar : ColorMapping, optional
+        Adds a horizontal colour bar under the grid (e.g. from :func:`~.colors.error_colors`).
+    legend : list of (name, colour), optional
+        Adds a legend of swatches (e.g. from :func:`~.colors.label_colors`).
+    suptitle : str, optional
+    dpi : int
+    **render_kw
+        Passed to :func:`render_mesh` (``edgecolor``, ``cull_backfaces``, ...).
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        Not registered with pyplot: display it (Jupyter shows it as the cell's result) or save it
+        with ``fig.savefig``; :func:`figure_to_png` gives the PNG bytes.
+    """
+    from matplotlib.figure import Figure
+
+    Vs = _as_mesh_list(meshes)
+    k = len(Vs)
+    if ncols < 1:
+        raise ValueError(f"ncols must be >= 1, got {ncols}")
+    if titles is not None and len(titles) != k:
+        raise ValueError(f"{len(titles)} titles for {k} meshes")
+    cols = _per_mesh(colors, k, len(Vs[0]))
+    nc = min(ncols, k)
+    nr = int(math.ceil(k / nc))
+    extra = 0.7 if (colorbar is not None or legend) else 0.0
+    top = (0.35 if suptitle else 0.0) + (0.25 if titles is not None else 0.0)
+    fig = Figure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
+    R = view_basis(view, up)
+    extent = None
+    if same_scale:
+        extent = 0.55 * max(float(np.max(np.ptp(V @ R[:2].T, axis=0))) for V in Vs)
+    axes = []
+    for i, V in enumerate(Vs):
+        ax = fig.add_subplot(nr, nc, i + 1)
+        render_mesh(ax, V, F, colors=cols[i], view=view, up=up, extent=extent, **render_kw)
+        if titles is not None:
+            ax.set_title(str(titles[i]), fontsize=10)
+        axes.append(ax)
+    bottom = extra / (size * nr + extra + top)
+    fig.subplots_adjust(left=0.01, right=0.99, top=1.0 - top / (size * nr + extra + top) - 0.01, bottom=bottom + 0.01, wspace=0.02, hspace=0.15 if titles is not None else 0.02)
+    if colorbar is not None:
+        from matplotlib.cm import ScalarMappable
+        from matplotlib.colors import Normalize
+
+        import matplotlib
+
+        cax = fig.add_axes([0.25, 0.62 * bottom, 0.5, 0.2 * bottom])
+        sm = ScalarMappable(norm=Normalize(colorbar.vmin, colorbar.vmax), cmap=matplotlib.colormaps[colorbar.cmap])
+        cb = fig.colorbar(sm, cax=cax, orientation="horizontal")
+        cb.ax.tick_params(labelsize=8)
+        if colorbar.label:
+            cb.set_label(colorbar.label, fontsize=9)
+    if legend:
+        from matplotlib.patches import Patch
+
+        handles = [Patch(facecolor=c, edgecolor="#666", label=str(n)) for n, c in legend]
+        fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
+    if suptitle:
+        fig.suptitle(suptitle)
+    return fig
+
+
+def figure_to_png(fig, dpi=None) -> bytes:
+    """PNG bytes of a matplotlib figure.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    dpi : int, optional
+        Default the figure's own dpi.
+
+    Returns
+    -------
+    png : bytes
+        Starts with the PNG signature ``b"\\x89PNG"``.
+    """
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
+    return buf.getvalue()
