@@ -317,11 +317,27 @@ def _write_off(path: Path, V: np.ndarray, F: np.ndarray) -> None:
         np.savetxt(fh, F, fmt="3 %d %d %d")
 
 
+def _write_ply(path: Path, V: np.ndarray, F: np.ndarray) -> None:
+    """Binary little-endian PLY with float64 vertices (trimesh's exporter writes float32)."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {len(V)}\nproperty double x\nproperty double y\nproperty double z\n"
+        f"element face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    faces = np.zeros(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    faces["n"] = 3
+    faces["v"] = F
+    with open(path, "wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(np.ascontiguousarray(V, dtype="<f8").tobytes())
+        fh.write(faces.tobytes())
+
+
 def write_mesh(path, V, F) -> Path:
     """Write one triangle mesh; the suffix picks the format (``.obj``, ``.off``, ``.ply``).
 
-    OBJ and OFF are written as text with 17 significant digits, so float64 positions survive a
-    round trip exactly; PLY is written by trimesh (binary).
+    OBJ and OFF are written as text with 17 significant digits and PLY as binary float64, so
+    positions survive a round trip exactly.
 
     Parameters
     ----------
@@ -348,9 +364,7 @@ def write_mesh(path, V, F) -> Path:
     elif suffix == ".off":
         _write_off(path, V, F)
     elif suffix == ".ply":
-        import trimesh
-
-        trimesh.Trimesh(V, F, process=False).export(path)
+        _write_ply(path, V, F)
     else:
         raise ValueError(f"unknown mesh format {suffix!r} for {path}; use .obj, .off or .ply")
     return path
@@ -520,7 +534,7 @@ def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshColl
         dup = sorted({s for s in stems if stems.count(s) > 1})
         raise ValueError(f"{path}: several files share the name(s) {dup[:5]} (different suffixes)")
     it = files
-    if progress:
+    if progress and len(files) > 20:
         from tqdm.auto import tqdm
 
         it = tqdm(files, desc="reading meshes", unit="mesh")
