@@ -170,6 +170,25 @@ class DeformationGradientOperator:
                 t[3 * a + b] += (ma * h[:, b]).reshape(-1)
         return t
 
+    def _normal_sums_batch(self, V: np.ndarray) -> np.ndarray:
+        """:func:`vertex_normal_sums` of ``(N, n, 3)`` with the incidence matrix built once."""
+        if not hasattr(self, "_incidence"):
+            m = len(self.faces)
+            self._incidence = sp.csr_matrix(
+                (np.ones(3 * m), (self.faces.reshape(-1), np.repeat(np.arange(m), 3))),
+                shape=(self.n_vertices, m))
+        F = self.faces
+        p0 = V[:, F[:, 0], :]
+        a = V[:, F[:, 1], :] - p0
+        b = V[:, F[:, 2], :] - p0
+        c = np.empty_like(a)
+        c[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+        c[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+        c[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+        N, m = V.shape[0], len(F)
+        acc = self._incidence @ c.transpose(1, 0, 2).reshape(m, N * 3)
+        return np.asarray(acc).reshape(self.n_vertices, N, 3).transpose(1, 0, 2)
+
     def deformed_normal_edges(self, V) -> np.ndarray:
         """Deformed normal edges ``m'_i = l' n'_i``.
 
@@ -186,8 +205,8 @@ class DeformationGradientOperator:
         -------
         m : (n_meshes, n_vertices, 3) float64
         """
-        acc = vertex_normal_sums(V, self.faces)
-        na = np.linalg.norm(acc, axis=-1, keepdims=True)
+        acc = self._normal_sums_batch(V)
+        na = np.sqrt(np.einsum("...k,...k->...", acc, acc))[..., None]
         scale = self.normal_length / np.sqrt(np.maximum(na, 1e-300) * self._normal_sum_norms[:, None])
         return acc * scale
 
