@@ -1,0 +1,123 @@
+"""Collections of the humanoid: SCAPE-like, Dyna-like and a Jumping-like sequence."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from data_synth import constants as C
+from data_synth.collection import SynthCollection
+from data_synth.humanoid import NAMES, BodyShape, body_template, pose_body, shape_body
+from data_synth.motions import MOTIONS, Pose, motion_sequence, random_poses
+from data_synth.skeleton import forward_kinematics
+
+__all__ = ["make_scape", "make_dyna", "make_jumping", "DYNA_SHAPES", "pose_shape"]
+
+#: the Dyna-like collection's body shapes (jittered a little per seed).
+DYNA_SHAPES = {
+    "male_average": BodyShape(height=1.78, girth=1.0, body_type="male"),
+    "male_heavy": BodyShape(height=1.72, girth=1.3, arm_length=0.97, body_type="male"),
+    "female_slim": BodyShape(height=1.66, girth=0.88, leg_length=1.04, body_type="female"),
+    "female_heavy": BodyShape(height=1.62, girth=1.22, shoulder_width=0.95, body_type="female"),
+    "male_tall_slim": BodyShape(height=1.92, girth=0.86, leg_length=1.06, arm_length=1.04,
+                                body_type="male"),
+}
+
+
+def pose_shape(template, shape: BodyShape, pose: Pose) -> np.ndarray:
+    """Meshes ``(n_frames, n_vertices, 3) float64`` of body ``shape`` in every frame of ``pose``.
+
+    Joints listed in ``pose.plant`` keep their rest height (the lowest one) and their mean
+    horizontal position, so feet stay on the ground.
+    """
+    V_rest, joints = shape_body(template, shape)
+    root = pose.root.copy()
+    if pose.plant:
+        idx = [NAMES.index(n) for n in pose.plant]
+        _, p = forward_kinematics(template.skeleton, pose.local, np.zeros_like(root), rest=joints)
+        root[:, 1] = joints[idx, 1].min() - p[:, idx, 1].min(axis=1) + pose.root[:, 1]
+        root[:, [0, 2]] = joints[idx][:, [0, 2]].mean(0) - p[:, idx][:, :, [0, 2]].mean(1)
+    return pose_body(V_rest, joints, template, pose.local, root)
+
+
+def _jitter(shape: BodyShape, rng: np.random.Generator) -> BodyShape:
+    j = lambda v: float(v * rng.uniform(0.98, 1.02))  # noqa: E731
+    return BodyShape(height=j(shape.height), girth=j(shape.girth), arm_length=j(shape.arm_length),
+                     leg_length=j(shape.leg_length), shoulder_width=j(shape.shoulder_width),
+                     body_type=shape.body_type)
+
+
+def make_scape(seed: int = 0, resolution: int | None = None,
+               n_poses: int = C.SCAPE_N_POSES) -> SynthCollection:
+    """One body in ``n_poses`` distinct poses (the paper's SCAPE has 71), rest pose first."""
+    rng = np.random.default_rng(seed)
+    template = body_template(resolution)
+    shape = _jitter(BodyShape(), rng)
+    pose, sources = random_poses(n_poses - 1, rng)
+    rest = Pose.identity(1)
+    pose = Pose(np.concatenate([rest.local, pose.local]), np.concatenate([rest.root, pose.root]),
+                plant=pose.plant)
+    V = pose_shape(template, shape, pose)
+    return SynthCollection(
+        vertices=V, faces=template.F.copy(),
+        names=[f"pose_{i:03d}" for i in range(n_poses)],
+        labels={"source_motion": np.array(["rest"] + sources)},
+        description="SCAPE-like: one body in many distinct poses",
+        extras={"rest": V[0].copy(), "shape_params": shape.as_dict()},
+    )
+
+
+def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions=None,
+              frames_per_motion: int = C.DYNA_FRAMES_PER_MOTION) -> SynthCollection:
+    """Several body shapes x several motions (Dyna-like), labelled ``shape``, ``motion``, ``frame``.
+
+    ``extras['shape_params']`` maps each shape name to its parameters; ``extras['shape_matrix']``
+    is ``(n_shapes, 5) float64`` (height, girth, arm_length, leg_length, shoulder_width) in the
+    order of ``extras['shape_names']``, and ``extras['body_type']`` gives male/female per shape.
+    """
+    rng = np.random.default_rng(seed)
+    template = body_template(resolution)
+    shapes = list(DYNA_SHAPES) if shapes is None else list(shapes)
+    motions = list(MOTIONS) if motions is None else list(motions)
+    for s in shapes:
+        if s not in DYNA_SHAPES:
+            raise ValueError(f"unknown body shape {s!r}; shapes are {sorted(DYNA_SHAPES)}")
+    chunks, names, lab_shape, lab_motion, lab_frame = [], [], [], [], []
+    params = {}
+    for s in shapes:  # a few shapes x a few motions; each block is vectorised
+        shape = _jitter(DYNA_SHAPES[s], rng)
+        params[s] = shape.as_dict()
+        for m in motions:
+            pose = motion_sequence(m, frames_per_motion, rng)
+            chunks.append(pose_shape(template, shape, pose))
+            for f in range(frames_per_motion):
+                names.append(f"{s}_{m}_{f:02d}")
+                lab_shape.append(s)
+                lab_motion.append(m)
+                lab_frame.append(f)
+    keys = ("height", "girth", "arm_length", "leg_length", "shoulder_width")
+    return SynthCollection(
+        vertices=np.concatenate(chunks), faces=template.F.copy(), names=names,
+        labels={"shape": np.array(lab_shape), "motion": np.array(lab_motion),
+                "frame": np.array(lab_frame, dtype=np.int64)},
+        description=f"Dyna-like: {len(shapes)} body shapes x {len(motions)} motions",
+        extras={"rest": template.V.copy(), "shape_params": params, "shape_names": shapes,
+                "shape_param_names": list(keys),
+                "shape_matrix": np.array([[params[s][k] for k in keys] for s in shapes]),
+                "body_type": [params[s]["body_type"] for s in shapes]},
+    )
+
+
+def make_jumping(seed: int = 0, resolution: int | None = None,
+                 n_frames: int = C.JUMPING_N_FRAMES) -> SynthCollection:
+    """One body doing jumping jacks, a smooth sequence (like Vlasic et al.'s 'Jumping')."""
+    rng = np.random.default_rng(seed)
+    template = body_template(resolution)
+    shape = _jitter(BodyShape(height=1.70, girth=0.95), rng)
+    pose = motion_sequence("jumping_jacks", n_frames, rng)
+    V = pose_shape(template, shape, pose)
+    return SynthCollection(
+        vertices=V, faces=template.F.copy(), names=[f"frame_{i:03d}" for i in range(n_frames)],
+        labels={"frame": np.arange(n_frames, dtype=np.int64)},
+        description="Jumping-like: one body doing jumping jacks, a smooth sequence",
+        extras={"rest": shape_body(template, shape)[0], "shape_params": shape.as_dict()},
+    )

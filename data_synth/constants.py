@@ -1,0 +1,70 @@
+"""Every constant of ``data_synth`` in one place: sizes, tolerances and default counts.
+
+Lengths are in metres for the humanoid, hand and face (so a body is about 1.75 high); the flag and
+the bar use their own unit lengths. Resolutions are *approximate vertex counts* of a template.
+"""
+
+# --- template meshing (implicit surface -> triangle mesh) -------------------------------------
+#: vertices per unit surface area times squared grid spacing, measured for marching cubes
+#: followed by relaxation; used to pick the grid spacing for a target vertex count.
+MC_VERTEX_DENSITY = 1.05
+#: extra grid cells around the bounding box of the implicit surface (keeps the surface closed).
+MC_PADDING_CELLS = 3
+#: tangential relaxation rounds after marching cubes.
+RELAX_ITERATIONS = 12
+#: step of one relaxation round (fraction of the move towards the one-ring centroid).
+RELAX_STEP = 0.6
+#: Newton steps that pull a relaxed vertex back onto the implicit surface.
+REPROJECT_STEPS = 2
+#: finite-difference step for implicit-function gradients, in units of the grid spacing.
+GRADIENT_STEP = 0.25
+#: edges shorter than this fraction of the mean edge length are collapsed after marching cubes.
+SHORT_EDGE_FRACTION = 0.3
+
+# --- quality limits the generators guarantee (and the tests check) -----------------------------
+#: every triangle keeps at least this fraction of its rest-pose area in every frame.
+MIN_AREA_RATIO = 0.05
+#: and at most this multiple of it.
+MAX_AREA_RATIO = 8.0
+#: every edge keeps its length within [MIN_EDGE_RATIO, MAX_EDGE_RATIO] x its rest length.
+MIN_EDGE_RATIO = 0.2
+MAX_EDGE_RATIO = 3.0
+#: a deformed face normal may turn at most this far (degrees) from its rest normal after the
+#: rest-to-frame rotation of its neighbourhood is removed; see docs/data_synth.md.
+MAX_LOCAL_NORMAL_TURN_DEG = 100.0
+#: smallest interior angle (degrees) of any template triangle.
+MIN_TEMPLATE_ANGLE_DEG = 10.0
+
+# --- humanoid ---------------------------------------------------------------------------------
+#: default and allowed vertex counts of the body template.
+HUMANOID_DEFAULT_RESOLUTION = 2500
+MIN_RESOLUTION = 300
+MAX_RESOLUTION = 40000
+#: rest pose: arms this many degrees below horizontal (an A-pose keeps arms off the torso).
+ARM_REST_ANGLE_DEG = 45.0
+#: smooth-union blend radius of the body's implicit primitives (metres).
+BODY_BLEND_RADIUS = 0.035
+#: width (metres) over which skinning weights blend across a joint.
+SKIN_BLEND_WIDTH = 0.06
+#: default number of poses in the SCAPE-like collection (the paper's SCAPE has 71).
+SCAPE_N_POSES = 71
+#: default number of frames of the jumping-jacks sequence (Vlasic's Jumping has 150).
+JUMPING_N_FRAMES = 120
+#: default frames per motion in the Dyna-like collection.
+DYNA_FRAMES_PER_MOTION = 6
+
+# --- hand and face ----------------------------------------------------------------------------
+HAND_DEFAULT_RESOLUTION = 1800
+HAND_BLEND_RADIUS = 0.006
+HAND_SKIN_BLEND_WIDTH = 0.012
+FACE_DEFAULT_RESOLUTION = 2000
+FACE_BLEND_RADIUS = 0.02
+
+# --- flag and bar -----------------------------------------------------------------------------
+FLAG_DEFAULT_RESOLUTION = 1200
+FLAG_ASPECT = 1.5
+FLAG_N_FRAMES = 100
+BAR_DEFAULT_RESOLUTION = 1000
+BAR_LENGTH = 4.0
+BAR_RADIUS = 0.35
+BAR_N_FRAMES_PER_MOTION = 20

@@ -1,0 +1,149 @@
+"""A head (closed surface) with blendshape-style expressions.
+
+The neutral head is an implicit model (cranium, jaw, cheeks, nose, brow ridge, lips, chin, ears
+and a neck stump; a mouth groove and eye sockets carved out), polygonised once. Each *blendshape*
+is a smooth displacement field of the neutral vertices (Gaussian-weighted moves of the mouth
+corners, brows, lips and cheeks, and a jaw rotation weighted below the mouth); an *expression* is a
+weighted sum of blendshapes, ramped from neutral to its peak.
+
+Coordinates (metres): the head's centre near the origin, y up, the face looking along +z.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from data_synth import constants as C
+from data_synth.collection import SynthCollection
+from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
+from data_synth.skeleton import axis_rotation
+
+__all__ = ["make_face", "face_template", "blendshapes", "EXPRESSIONS"]
+
+#: expression -> blendshape weights at its peak
+EXPRESSIONS = {
+    "smile": {"smile": 1.0, "cheek_raise": 0.8},
+    "laugh": {"smile": 1.0, "cheek_raise": 1.0, "jaw_open": 0.6},
+    "surprise": {"jaw_open": 0.9, "brow_raise": 1.0},
+    "angry": {"brow_lower": 1.0, "mouth_corners_down": 0.5, "lip_press": 0.6},
+    "sad": {"mouth_corners_down": 1.0, "brow_inner_up": 1.0},
+    "kiss": {"pucker": 1.0},
+    "puff": {"cheek_puff": 1.0},
+    "shout": {"jaw_open": 1.0, "brow_lower": 0.6, "mouth_stretch": 0.6},
+}
+
+
+def _face_model() -> ImplicitModel:
+    prims = [
+        Ellipsoid((0.0, 0.03, -0.01), (0.075, 0.098, 0.095), 0),
+        Ellipsoid((0.0, -0.035, 0.025), (0.058, 0.06, 0.07), 0),
+        Ellipsoid((0.0, -0.09, 0.06), (0.026, 0.02, 0.022), 0),  # chin
+        Ellipsoid((0.038, -0.005, 0.06), (0.027, 0.026, 0.03), 0),
+        Ellipsoid((-0.038, -0.005, 0.06), (0.027, 0.026, 0.03), 0),
+        Capsule((0.0, 0.02, 0.088), (0.0, -0.013, 0.112), 0.007, 0.013, 0),  # nose
+        Capsule((-0.042, 0.043, 0.078), (0.042, 0.043, 0.078), 0.011, 0.011, 0),  # brow ridge
+        Ellipsoid((0.0, -0.036, 0.092), (0.025, 0.0075, 0.012), 0),  # upper lip
+        Ellipsoid((0.0, -0.052, 0.088), (0.023, 0.0085, 0.012), 0),  # lower lip
+        Ellipsoid((0.078, 0.005, -0.015), (0.012, 0.03, 0.02), 0),  # ears
+        Ellipsoid((-0.078, 0.005, -0.015), (0.012, 0.03, 0.02), 0),
+        Capsule((0.0, -0.06, -0.025), (0.0, -0.17, -0.03), 0.05, 0.052, 0),  # neck
+    ]
+    carve = [
+        Ellipsoid((0.0, -0.044, 0.103), (0.027, 0.0022, 0.016), 0),  # mouth line
+        Ellipsoid((0.032, 0.02, 0.096), (0.016, 0.009, 0.012), 0),  # eye sockets
+        Ellipsoid((-0.032, 0.02, 0.096), (0.016, 0.009, 0.012), 0),
+    ]
+    return ImplicitModel(prims, blend=C.FACE_BLEND_RADIUS, subtract=carve, subtract_blend=0.006)
+
+
+@functools.lru_cache(maxsize=4)
+def _cached(resolution: int):
+    V, F = polygonize(_face_model(), resolution, area_estimate=0.09)
+    V.setflags(write=False)
+    F.setflags(write=False)
+    return V, F
+
+
+def face_template(resolution: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Neutral head ``(V (n, 3) float64, F (m, 3) int64)``, cached and read-only."""
+    resolution = C.FACE_DEFAULT_RESOLUTION if resolution is None else int(resolution)
+    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
+        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
+                         f"got {resolution}")
+    return _cached(resolution)
+
+
+def _gauss(V, center, sigma):
+    return np.exp(-0.5 * np.sum(((V - np.asarray(center)) / np.asarray(sigma)) ** 2, axis=1))
+
+
+def _smoothstep(x):
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
+    """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1."""
+    x = V[:, 0]
+    front = _smoothstep((V[:, 2] - 0.03) / 0.04)
+    sx = np.sign(x)
+    out = {}
+    corner = sum(_gauss(V, (s * 0.026, -0.044, 0.092), (0.014, 0.012, 0.02)) for s in (1, -1))
+    out["smile"] = np.stack([0.006 * sx, 0.007 * np.ones_like(x), -0.004 * np.ones_like(x)], 1) * corner[:, None]
+    out["mouth_corners_down"] = np.stack([0.001 * sx, -0.006 * np.ones_like(x), np.zeros_like(x)], 1) * corner[:, None]
+    out["mouth_stretch"] = np.stack([0.006 * sx, -0.002 * np.ones_like(x), np.zeros_like(x)], 1) * corner[:, None]
+    cheek = sum(_gauss(V, (s * 0.04, -0.005, 0.07), (0.02, 0.018, 0.02)) for s in (1, -1))
+    out["cheek_raise"] = np.array([0.0, 0.004, 0.003]) * cheek[:, None]
+    brow = sum(_gauss(V, (s * 0.03, 0.047, 0.085), (0.025, 0.014, 0.03)) for s in (1, -1))
+    out["brow_raise"] = np.array([0.0, 0.008, 0.001]) * brow[:, None]
+    out["brow_lower"] = np.stack([-0.003 * sx, -0.005 * np.ones_like(x), 0.002 * np.ones_like(x)], 1) * brow[:, None]
+    inner = _gauss(V, (0.0, 0.045, 0.085), (0.018, 0.014, 0.03))
+    out["brow_inner_up"] = np.array([0.0, 0.006, 0.0]) * inner[:, None]
+    lips = _gauss(V, (0.0, -0.044, 0.095), (0.02, 0.014, 0.02))
+    out["pucker"] = np.stack([-0.3 * x, np.zeros_like(x), 0.009 * np.ones_like(x)], 1) * lips[:, None]
+    out["lip_press"] = np.stack([np.zeros_like(x), -0.002 * np.sign(V[:, 1] + 0.044),
+                                 -0.002 * np.ones_like(x)], 1) * lips[:, None]
+    puff = sum(_gauss(V, (s * 0.045, -0.035, 0.055), (0.018, 0.02, 0.025)) for s in (1, -1))
+    normals_out = V - np.array([0.0, -0.03, 0.0])
+    normals_out /= np.linalg.norm(normals_out, axis=1, keepdims=True)
+    out["cheek_puff"] = 0.01 * puff[:, None] * normals_out
+    # jaw: rotate everything below the mouth about a hinge near the ears, fading into the neck
+    pivot = np.array([0.0, -0.01, -0.02])
+    below = _smoothstep((-0.044 - V[:, 1]) / 0.03 + 0.35)
+    not_neck = _smoothstep((V[:, 2] - 0.0) / 0.05)
+    w = below * not_neck * front
+    R = axis_rotation((1.0, 0.0, 0.0), 0.3)
+    out["jaw_open"] = ((V - pivot) @ R.T + pivot - V) * w[:, None]
+    return out
+
+
+def make_face(seed: int = 0, resolution: int | None = None,
+              frames_per_expression: int = 10) -> SynthCollection:
+    """Every expression ramped from neutral to its peak; labels ``expression``, ``frame``,
+    ``intensity_pct``."""
+    V0, F = face_template(resolution)
+    V0 = np.array(V0)
+    shapes = blendshapes(V0)
+    rng = np.random.default_rng(seed)
+    ramp = np.linspace(0.0, 1.0, frames_per_expression)
+    ramp = ramp * ramp * (3 - 2 * ramp)
+    chunks, names, expr, frame, inten = [], [], [], [], []
+    for e, weights in EXPRESSIONS.items():
+        field = np.zeros_like(V0)
+        for b, w in weights.items():
+            field += w * rng.uniform(0.85, 1.1) * shapes[b]
+        chunks.append(V0[None] + ramp[:, None, None] * field[None])
+        for f in range(frames_per_expression):
+            names.append(f"{e}_{f:02d}")
+            expr.append(e)
+            frame.append(f)
+            inten.append(int(round(100 * ramp[f])))
+    return SynthCollection(
+        vertices=np.concatenate(chunks), faces=np.array(F), names=names,
+        labels={"expression": np.array(expr), "frame": np.array(frame, dtype=np.int64),
+                "intensity_pct": np.array(inten, dtype=np.int64)},
+        description="a head with blendshape expressions ramped from neutral to their peak",
+        extras={"rest": V0, "blendshape_names": sorted(shapes)},
+    )
