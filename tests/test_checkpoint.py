@@ -1,0 +1,146 @@
+"""MeshVAEModel and its checkpoint: round trip, foreign/corrupted files, conditioning."""
+
+import pickle
+
+import numpy as np
+import pytest
+import torch
+
+from meshvae_lib.checkpoint import MeshVAEModel, load_model, save_model
+from meshvae_lib.mesh_io import MeshCollection
+from meshvae_lib.training import TrainConfig
+
+torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
+
+
+def strip_collection(n=32, seed=0, nx=10, ny=3):
+    """Strips bent into an arc (label ``mode`` = "arc") or an S ("s") by an angle (``amount``)."""
+    rng = np.random.default_rng(seed)
+    s = np.linspace(0, 3, nx)
+    F = []
+    for i in range(nx - 1):
+        for j in range(ny - 1):
+            a = i * ny + j
+            F += [[a, a + ny, a + 1], [a + ny, a + ny + 1, a + 1]]
+    Vs, mode, amount = [], [], []
+    for k in range(n):
+        t = rng.uniform(0.5, 2.0)
+        arc = k % 2 == 0
+        kappa = np.full(nx, t / 3) if arc else np.where(s < 1.5, 2 * t / 3, -2 * t / 3)
+        theta = np.concatenate([[0.0], np.cumsum(0.5 * (kappa[1:] + kappa[:-1]) * np.diff(s))])
+        ds = np.diff(s)
+        x = np.concatenate([[0.0], np.cumsum(ds * np.cos(0.5 * (theta[1:] + theta[:-1])))])
+        z = np.concatenate([[0.0], np.cumsum(ds * np.sin(0.5 * (theta[1:] + theta[:-1])))])
+        V = np.array([[x[i], w, z[i]] for i in range(nx) for w in np.linspace(0, 0.6, ny)])
+        Vs.append(V)
+        mode.append("arc" if arc else "s")
+        amount.append(t)
+    return MeshCollection(np.array(Vs), np.array(F), labels={"mode": np.array(mode), "amount": np.array(amount)})
+
+
+@pytest.fixture(scope="module")
+def collection():
+    return strip_collection()
+
+
+@pytest.fixture(scope="module")
+def model(collection):
+    cfg = TrainConfig(epochs=20, latent_dim=6, batch_size=8, progress=False, sigma_object=(0.5,))
+    return MeshVAEModel("rimd", cfg, holdout_every=4).fit(collection)
+
+
+def test_checkpoint_round_trip_decodes_identically(model, collection, tmp_path):
+    path = model.save(tmp_path / "m.pt")
+    loaded = load_model(path, collection)
+    z = model.sample_latent(5, seed=2)
+    np.testing.assert_array_equal(loaded.decode_latent(z), model.decode_latent(z))
+    np.testing.assert_array_equal(loaded.encode_meshes(collection), model.encode_meshes(collection))
+    np.testing.assert_array_equal(loaded.generate(3, seed=1), model.generate(3, seed=1))
+    np.testing.assert_array_equal(loaded.holdout_mask_, model.holdout_mask_)
+    np.testing.assert_array_equal(loaded.sigma_object_, [0.5] + [1.0] * 5)
+    np.testing.assert_array_equal(loaded.normalizer_.min_, model.normalizer_.min_)
+    assert loaded.history_ == model.history_
+    assert loaded.extractor_.kind == "rimd" and loaded.network_.config() == model.network_.config()
+    assert not [p for p in tmp_path.iterdir() if p.name != "m.pt"]  # no temporary file left behind
+
+
+def test_bundle_shapes_and_reconstruction(model, collection):
+    n, nv = len(collection), collection.n_vertices
+    z, s = model.encode_meshes(collection.vertices, return_sigma=True)
+    assert z.shape == (n, 6) and s.shape == (n, 6) and z.dtype == np.float64
+    assert model.decode_latent(z).shape == (n, nv, 3)
+    assert model.decode_latent(z[0]).shape == (nv, 3)
+    assert model.reconstruct(collection.vertices[:2]).shape == (2, nv, 3)
+    with pytest.raises(ValueError, match=r"\(N, 6\)"):
+        model.decode_latent(np.zeros((2, 5)))
+    assert "rimd" in repr(model)
+
+
+def test_model_for_another_mesh_is_refused(model, tmp_path):
+    path = model.save(tmp_path / "m.pt")
+    other = strip_collection(n=4, nx=8)
+    with pytest.raises(ValueError, match="30 vertices, got 24"):
+        load_model(path, other)
+    same_size = strip_collection(n=4)
+    same_size.faces = same_size.faces[:, [0, 2, 1]]
+    with pytest.raises(ValueError, match="connectivity"):
+        load_model(path, same_size)
+
+
+def test_corrupted_truncated_and_foreign_files_give_clear_errors(model, tmp_path):
+    good = model.save(tmp_path / "m.pt").read_bytes()
+    (tmp_path / "trunc.pt").write_bytes(good[: len(good) // 2])
+    (tmp_path / "noise.pt").write_bytes(np.random.default_rng(0).bytes(2000))
+    (tmp_path / "text.pt").write_text("hello")
+    torch.save({"weights": torch.zeros(3)}, tmp_path / "other.pt")
+    with open(tmp_path / "pickle.pt", "wb") as fh:
+        pickle.dump(np.zeros(3), fh, protocol=2)
+    for name in ("trunc.pt", "noise.pt", "text.pt", "other.pt", "pickle.pt"):
+        with pytest.raises(ValueError, match="checkpoint"):
+            load_model(tmp_path / name)
+    # flip bytes inside the stored weights: the checksum catches what the zip reader does not
+    payload = torch.load(tmp_path / "m.pt", weights_only=True)
+    key = next(iter(payload["network_state"]))
+    payload["network_state"][key] = payload["network_state"][key] + 1e-3
+    torch.save(payload, tmp_path / "tampered.pt")
+    with pytest.raises(ValueError, match="corrupted"):
+        load_model(tmp_path / "tampered.pt")
+    with pytest.raises(FileNotFoundError):
+        load_model(tmp_path / "missing.pt")
+
+
+def test_unfitted_model_and_missing_labels(collection):
+    with pytest.raises(ValueError, match="not trained"):
+        MeshVAEModel().decode_latent(np.zeros((1, 4)))
+    with pytest.raises(ValueError, match="no label column"):
+        MeshVAEModel("aligned", TrainConfig(epochs=1, progress=False), labels=["colour"]).fit(collection)
+
+
+def test_conditioning_changes_what_is_generated(collection, tmp_path):
+    # a small alpha and latent space make the KL term push the class information into the condition
+    cfg = TrainConfig(epochs=300, latent_dim=2, batch_size=32, lr=1e-2, progress=False, alpha=100.0, seed=0)
+    model = MeshVAEModel("aligned", cfg, labels=["mode"]).fit(collection)
+    assert model.is_conditional and model.network_.n_conditions == 2
+    arc = model.generate(6, seed=5, condition={"mode": "arc"})
+    s_shape = model.generate(6, seed=5, condition={"mode": "s"})
+    V = collection.vertices
+    is_arc = collection.labels["mode"] == "arc"
+
+    def nearest_is_arc(G):
+        d = np.linalg.norm((G[:, None] - V[None]).reshape(len(G), len(V), -1), axis=-1)
+        return is_arc[np.argmin(d, axis=1)]
+
+    # same latent samples, different condition: different meshes, each like its own class
+    assert np.mean(np.linalg.norm(arc - s_shape, axis=-1)) > 0.1
+    assert nearest_is_arc(arc).mean() >= 5 / 6
+    assert nearest_is_arc(s_shape).mean() <= 1 / 6
+    # conditions survive the checkpoint; bad values are refused
+    loaded = load_model(model.save(tmp_path / "c.pt"), collection)
+    np.testing.assert_array_equal(loaded.generate(2, seed=1, condition={"mode": "s"}),
+                                  model.generate(2, seed=1, condition={"mode": "s"}))
+    with pytest.raises(ValueError, match="known values"):
+        model.generate(2, condition={"mode": "jump"})
+    with pytest.raises(ValueError, match="unknown condition columns"):
+        model.generate(2, condition={"colour": "red"})
+    with pytest.raises(ValueError, match="conditional"):
+        model.encode_meshes(collection.vertices)
