@@ -146,3 +146,34 @@ def test_bad_input(bar):
     f[3] = np.nan
     with pytest.raises(ValueError, match="NaN"):
         rec.reconstruct(f)
+
+
+def test_reflected_one_rings_keep_rotations_and_reconstruct():
+    # mirror a curved mesh: T_i has det < 0 at (almost) every vertex
+    from meshvae_lib.deformation_gradient import deformation_gradients
+    from meshvae_lib.rotations import polar_decomposition
+
+    V0, F = icosphere(2)
+    V0 = bumpy(V0, seed=8)
+    mirrored = V0 * [-1.0, 1.0, 1.0]
+    T = deformation_gradients(V0, mirrored, F)
+    assert np.mean(np.linalg.det(T) < 0) > 0.9
+    R, S = polar_decomposition(T)
+    np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
+    np.testing.assert_allclose(R @ S, T, atol=1e-12)
+    f = RIMDEncoder(V0, F).transform(mirrored)
+    assert np.all(np.isfinite(f))
+    assert _error(RIMDReconstructor(V0, F).reconstruct(f), mirrored).max() < 1e-8
+
+
+def test_irregular_mesh_with_obtuse_and_sliver_triangles():
+    from meshvae_lib.cotangent import cotangent_weights
+    from meshvae_lib import tolerances as tol
+
+    V0, F = tube(10, 12)
+    V0 = bumpy(V0, 0.6, seed=9)  # strong bumps: obtuse and thin triangles
+    assert np.mean(cotangent_weights(V0, F, clamp=False) < 0) > 0.02
+    assert np.any(cotangent_weights(V0, F) == tol.COT_WEIGHT_MIN)
+    V = twist_bend(V0, 270.0, 90.0)
+    f = RIMDEncoder(V0, F).transform(V)
+    assert _error(RIMDReconstructor(V0, F).reconstruct(f), V).max() < 1e-8
