@@ -138,6 +138,8 @@ class MeshViewer:
             self._image = ImageView(list(Vs), self.F, colors=self._colors, titles=self.titles,
                                     colorbar=self.mapping, legend=self.legend, mode=self.mode)
             self.widget = self._image.widget
+            if self.widget is not None:
+                self.widget.add_class("meshvae-viewer")
 
     # -- colours -------------------------------------------------------------------------------
     def _resolve_colors(self, colors, values, cmap, vmin, vmax, value_label, labels) -> list[np.ndarray]:
@@ -239,6 +241,7 @@ class MeshViewer:
         self._caption = W.HTML(self._caption_html())
         parts.append(self._caption)
         self.widget = W.VBox(parts)
+        self.widget.add_class("meshvae-viewer")  # a stable hook for styling and browser tests
 
     def reset_camera(self):
         """Put the camera back where it started (threejs mode; no-op otherwise)."""

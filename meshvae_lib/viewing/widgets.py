@@ -100,6 +100,7 @@ class FramePlayer(_Displayable):
         self.slider.observe(self._on_frame, names="value")
         self.widget = W.VBox([self.viewer.widget, W.HBox([self.play, self.slider])]) if self.viewer.widget is not None \
             else W.HBox([self.play, self.slider])
+        self.widget.add_class("meshvae-frame-player")
 
     def _on_frame(self, change):
         self.viewer.update(list(self._frames[int(change["new"])]))
@@ -181,6 +182,7 @@ class LatentPad:
         x_slider.observe(self._on_slider, names="value")
         y_slider.observe(self._on_slider, names="value")
         self.widget = W.HBox([*parts, W.VBox([W.HTML("<b>2D pad</b>"), x_slider, y_slider])])
+        self.widget.add_class("meshvae-latent-pad")
 
     @staticmethod
     def _to_unit(s) -> float:
@@ -348,6 +350,9 @@ class LatentExplorer(_Displayable):
         controls += others
         panel = W.VBox(controls)
         self.widget = W.VBox([self.viewer.widget, panel]) if self.viewer.widget is not None else panel
+        self.widget.add_class("meshvae-latent-explorer")
+        for d, s in self.sliders.items():
+            s.add_class(f"meshvae-z{d}")
         self._refresh_status()
 
     # -- decoding ------------------------------------------------------------------------------
@@ -483,6 +488,7 @@ class InterpolationSlider(_Displayable):
                                     continuous_update=continuous_update, readout_format=".2f")
         self.slider.observe(self._on_t, names="value")
         self.widget = W.VBox([self.viewer.widget, self.slider]) if self.viewer.widget is not None else self.slider
+        self.widget.add_class("meshvae-interpolation")
 
     def mesh_at(self, t: float) -> np.ndarray:
         """The interpolated mesh at ``t``: ``(n_vertices, 3) float64``."""
