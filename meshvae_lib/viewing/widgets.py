@@ -361,10 +361,11 @@ class LatentExplorer(_Displayable):
         if hasattr(out, "detach"):  # a torch tensor
             out = out.detach().cpu().numpy()
         out = np.asarray(out, dtype=np.float64)
+        shape = out.shape
         if out.ndim == 2:
             out = out[None]
         if out.ndim != 3 or out.shape[2] != 3:
-            raise ValueError(f"decode(z) must return (n_vertices, 3) or (k, n_vertices, 3), got {out.shape}")
+            raise ValueError(f"decode(z) must return (n_vertices, 3) or (k, n_vertices, 3), got {shape}")
         self.n_decodes += 1
         return out
 

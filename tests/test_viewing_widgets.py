@@ -1,0 +1,198 @@
+"""Widget callbacks without a browser: frame player, latent explorer (sliders, pad, reset, random),
+interpolation slider. Each check goes through the widgets' own traits, as a browser would."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from meshvae_lib.topology import vertex_normals
+from meshvae_lib.viewing.widgets import FramePlayer, InterpolationSlider, LatentExplorer
+
+pytest.importorskip("pythreejs")
+
+
+@pytest.fixture
+def sphere():
+    m = trimesh.creation.icosphere(subdivisions=2)
+    return np.array(m.vertices), np.array(m.faces)
+
+
+class LinearDecoder:
+    """V(z) = V0 + sum_k z_k B_k; counts calls."""
+
+    def __init__(self, V0, latent_dim, seed=0):
+        self.V0 = V0
+        self.B = np.random.default_rng(seed).normal(scale=0.05, size=(latent_dim, len(V0), 3))
+        self.calls = []
+
+    def __call__(self, z):
+        self.calls.append(np.array(z))
+        return self.V0 + np.tensordot(z, self.B, axes=1)
+
+
+# -- frame player ------------------------------------------------------------------------------
+def test_frame_player_steps_through_the_sequence(sphere):
+    V, F = sphere
+    frames = np.stack([V * s for s in np.linspace(1.0, 2.0, 6)])
+    p = FramePlayer(frames, F, fps=12, mode="threejs")
+    assert p.n_frames == 6 and p.play.max == 5 and p.slider.max == 5 and p.play.interval == 83
+    p.slider.value = 3  # what the browser's Play button does through jslink
+    np.testing.assert_allclose(p.viewer.positions[0], frames[3], atol=1e-6)
+    np.testing.assert_allclose(p.viewer.normals[0], vertex_normals(frames[3], F), atol=1e-6)
+    assert p.step(2) == 5
+    assert p.step() == 0  # wraps
+    np.testing.assert_allclose(p.viewer.positions[0], frames[0], atol=1e-6)
+    with pytest.raises(ValueError, match="frame 9 out of range 0..5"):
+        p.frame = 9
+
+
+def test_frame_player_side_by_side_sequences(sphere):
+    V, F = sphere
+    a = np.stack([V * s for s in (1.0, 1.5, 2.0)])
+    b = a + [0.0, 0.1, 0.0]
+    p = FramePlayer([a, b], F, titles=["truth", "method"], mode="threejs")
+    p.frame = 2
+    np.testing.assert_allclose(p.viewer.positions[0], a[2], atol=1e-6)
+    np.testing.assert_allclose(p.viewer.positions[1], b[2], atol=1e-6)
+    with pytest.raises(ValueError, match="one shape"):
+        FramePlayer([a, b[:2]], F, mode="threejs")
+
+
+# -- latent explorer ---------------------------------------------------------------------------
+def test_moving_a_slider_decodes_and_updates_the_buffers(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 8)
+    e = LatentExplorer(dec, 8, F, dims=[0, 3, 5], mode="threejs")
+    assert e.n_decodes == 1 and set(e.sliders) == {0, 3, 5}
+    attr = e.viewer._pos_attrs[0]
+    e.sliders[3].value = 1.5
+    assert e.n_decodes == 2
+    np.testing.assert_allclose(dec.calls[-1], np.eye(8)[3] * 1.5)
+    expected = V + 1.5 * dec.B[3]
+    assert e.viewer._pos_attrs[0] is attr  # updated in place, not rebuilt
+    np.testing.assert_allclose(attr.array, expected, atol=1e-6)
+    np.testing.assert_allclose(e.viewer._nrm_attrs[0].array, vertex_normals(expected, F), atol=1e-5)
+    assert e.last_update_ms >= 0
+
+
+def test_reset_and_random_decode_once_and_random_is_seeded(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 6)
+    z0 = np.full(6, 0.25)
+    e = LatentExplorer(dec, 6, F, z0=z0, seed=7, random_scale=1.0, mode="threejs")
+    n = e.n_decodes
+    z = e.randomize()
+    assert e.n_decodes == n + 1  # six sliders moved, one decode
+    expected = np.clip(np.random.default_rng(7).standard_normal(6), -3, 3)
+    np.testing.assert_allclose(z, expected)
+    assert [e.sliders[d].value for d in range(6)] == pytest.approx(list(expected), abs=1e-9)
+    e2 = LatentExplorer(LinearDecoder(V, 6), 6, F, z0=z0, seed=7, mode="threejs")
+    np.testing.assert_allclose(e2.randomize(), z)
+    assert not np.allclose(e.randomize(), z)  # the next draw differs
+    e.reset_button.click()
+    np.testing.assert_allclose(e.z, z0)
+    np.testing.assert_allclose(e.viewer._pos_attrs[0].array, V + np.tensordot(z0, dec.B, axes=1), atol=1e-6)
+
+
+def test_random_only_touches_slider_dimensions(sphere):
+    V, F = sphere
+    z0 = np.arange(10, dtype=float) / 10
+    e = LatentExplorer(LinearDecoder(V, 10), 10, F, dims=[2, 4], z0=z0, mode="threejs")
+    z = e.randomize()
+    keep = [d for d in range(10) if d not in (2, 4)]
+    np.testing.assert_allclose(z[keep], z0[keep])
+
+
+def test_pad_click_sets_two_dimensions_with_one_decode(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 4)
+    e = LatentExplorer(dec, 4, F, value_range=(-2.0, 2.0), mode="threejs")
+    assert e.pad_dims == (0, 1) and e.pad.picker is not None
+    n = e.n_decodes
+    e.pad.picker.point = (0.5, -1.0, 0.0)  # what the browser's Picker reports on a click
+    assert e.n_decodes == n + 1
+    np.testing.assert_allclose(e.z[:2], [1.0, -2.0])
+    assert e.sliders[0].value == pytest.approx(1.0) and e.sliders[1].value == pytest.approx(-2.0)
+    assert e.pad.marker.position[:2] == pytest.approx((0.5, -1.0))
+    e.sliders[0].value = -2.0  # the marker follows the slider
+    assert e.pad.marker.position[0] == pytest.approx(-1.0)
+
+
+def test_displacement_colouring_and_reference(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 3)
+    e = LatentExplorer(dec, 3, F, reference=V, color_by="displacement", mode="threejs")
+    assert e.viewer.n_meshes == 2
+    e.sliders[1].value = 2.0
+    disp = np.linalg.norm(2.0 * dec.B[1], axis=1)
+    assert e.viewer.mapping.vmax == pytest.approx(disp.max())
+    np.testing.assert_allclose(e.viewer._pos_attrs[0].array, V, atol=1e-6)  # reference stays
+    c = e.viewer._color_attrs[1].array
+    lum = c.mean(axis=1)
+    assert lum[np.argmax(disp)] < lum[np.argmin(disp)]  # YlOrRd: more displacement is darker
+
+
+def test_explorer_accepts_a_model_and_batched_output(sphere):
+    V, F = sphere
+
+    class Model:
+        def decode_latent(self, z):
+            return np.stack([V * (1 + z[0]), V])  # two meshes per latent vector
+
+    e = LatentExplorer(Model(), 2, F, mode="threejs")
+    assert e.viewer.n_meshes == 2
+    e.sliders[0].value = 1.0
+    np.testing.assert_allclose(e.meshes[0], 2 * V, atol=1e-6)
+
+
+def test_explorer_validates(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 4)
+    with pytest.raises(ValueError, match=r"dims must be distinct indices in 0..3, got \[1, 9\]"):
+        LatentExplorer(dec, 4, F, dims=[1, 9], mode="threejs")
+    with pytest.raises(ValueError, match=r"z0 must have shape \(4,\)"):
+        LatentExplorer(dec, 4, F, z0=np.zeros(3), mode="threejs")
+    with pytest.raises(ValueError, match="pad_dims"):
+        LatentExplorer(dec, 4, F, dims=[0, 1], pad_dims=(0, 3), mode="threejs")
+    with pytest.raises(ValueError, match=r"\(162, 2\)"):
+        LatentExplorer(lambda z: V[:, :2], 4, F, mode="threejs")
+    with pytest.raises(ValueError, match="callable or have a decode_latent"):
+        LatentExplorer(42, 4, F, mode="threejs")
+
+
+def test_explorer_in_image_mode_has_sliders_but_no_pad_view(sphere):
+    V, F = sphere
+    e = LatentExplorer(LinearDecoder(V, 3), 3, F, mode="image")
+    png = e.viewer._image.png
+    e.sliders[2].value = 3.0
+    assert e.pad.picker is None and e.viewer._image.png != png
+
+
+# -- interpolation -----------------------------------------------------------------------------
+def test_interpolation_slider_blends_and_keeps_the_ends(sphere):
+    V, F = sphere
+    A, B = V, V * [2.0, 1.0, 0.5]
+    s = InterpolationSlider(A, B, F, mode="threejs")
+    assert s.viewer.n_meshes == 3
+    s.t = 0.25
+    np.testing.assert_allclose(s.viewer.positions[1], 0.75 * A + 0.25 * B, atol=1e-6)
+    np.testing.assert_allclose(s.viewer.positions[0], A, atol=1e-6)
+    np.testing.assert_allclose(s.viewer.positions[2], B, atol=1e-6)
+    with pytest.raises(ValueError, match=r"t must be in \[0, 1\], got 1.5"):
+        s.t = 1.5
+
+
+def test_interpolation_slider_with_a_custom_path(sphere):
+    V, F = sphere
+    seen = []
+
+    def path(t):
+        seen.append(t)
+        return V * (1.0 + t)
+
+    s = InterpolationSlider(V, 2 * V, F, interpolate=path, show_ends=False, mode="threejs")
+    s.slider.value = 0.5
+    assert seen[-1] == 0.5 and s.viewer.n_meshes == 1
+    np.testing.assert_allclose(s.viewer.positions[0], 1.5 * V, atol=1e-6)
