@@ -72,7 +72,8 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
 
     ``extras['shape_params']`` maps each shape name to its parameters; ``extras['shape_matrix']``
     is ``(n_shapes, 5) float64`` (height, girth, arm_length, leg_length, shoulder_width) in the
-    order of ``extras['shape_names']``, and ``extras['body_type']`` gives male/female per shape.
+    order of ``extras['shape_names']``, ``extras['body_type']`` gives male/female per shape and
+    ``extras['shape_rest']`` is ``(n_shapes, n_vertices, 3) float64``, each shape in the rest pose.
     """
     rng = np.random.default_rng(seed)
     template = body_template(resolution)
@@ -82,10 +83,11 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
         if s not in DYNA_SHAPES:
             raise ValueError(f"unknown body shape {s!r}; shapes are {sorted(DYNA_SHAPES)}")
     chunks, names, lab_shape, lab_motion, lab_frame = [], [], [], [], []
-    params = {}
+    params, shape_rest = {}, []
     for s in shapes:  # a few shapes x a few motions; each block is vectorised
         shape = _jitter(DYNA_SHAPES[s], rng)
         params[s] = shape.as_dict()
+        shape_rest.append(shape_body(template, shape)[0])
         for m in motions:
             pose = motion_sequence(m, frames_per_motion, rng)
             chunks.append(pose_shape(template, shape, pose))
@@ -101,6 +103,7 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
                 "frame": np.array(lab_frame, dtype=np.int64)},
         description=f"Dyna-like: {len(shapes)} body shapes x {len(motions)} motions",
         extras={"rest": template.V.copy(), "shape_params": params, "shape_names": shapes,
+                "shape_rest": np.stack(shape_rest),
                 "shape_param_names": list(keys),
                 "shape_matrix": np.array([[params[s][k] for k in keys] for s in shapes]),
                 "body_type": [params[s]["body_type"] for s in shapes]},

@@ -7,15 +7,19 @@ the bar use their own unit lengths. Resolutions are *approximate vertex counts* 
 # --- template meshing (implicit surface -> triangle mesh) -------------------------------------
 #: vertices per unit surface area times squared grid spacing, measured for marching cubes
 #: followed by relaxation; used to pick the grid spacing for a target vertex count.
-MC_VERTEX_DENSITY = 1.05
+MC_VERTEX_DENSITY = 0.88
 #: extra grid cells around the bounding box of the implicit surface (keeps the surface closed).
 MC_PADDING_CELLS = 3
+#: half-width, in coarse grid cells, of the band around the surface where the implicit function
+#: is evaluated exactly (elsewhere only its sign, from a grid twice as coarse, is kept).
+NARROW_BAND_CELLS = 2.5
 #: tangential relaxation rounds after marching cubes.
-RELAX_ITERATIONS = 12
+RELAX_ITERATIONS = 25
 #: step of one relaxation round (fraction of the move towards the one-ring centroid).
 RELAX_STEP = 0.6
-#: Newton steps that pull a relaxed vertex back onto the implicit surface.
-REPROJECT_STEPS = 2
+#: Newton steps that pull the relaxed vertices back onto the implicit surface at the end (one
+#: step follows every relaxation round).
+REPROJECT_STEPS = 3
 #: finite-difference step for implicit-function gradients, in units of the grid spacing.
 GRADIENT_STEP = 0.25
 #: edges shorter than this fraction of the mean edge length are collapsed after marching cubes.
@@ -28,7 +32,7 @@ MIN_AREA_RATIO = 0.05
 MAX_AREA_RATIO = 8.0
 #: every edge keeps its length within [MIN_EDGE_RATIO, MAX_EDGE_RATIO] x its rest length.
 MIN_EDGE_RATIO = 0.2
-MAX_EDGE_RATIO = 3.0
+MAX_EDGE_RATIO = 4.0
 #: a deformed face normal may turn at most this far (degrees) from its rest normal after the
 #: rest-to-frame rotation of its neighbourhood is removed; see docs/data_synth.md.
 MAX_LOCAL_NORMAL_TURN_DEG = 100.0
@@ -45,7 +49,7 @@ ARM_REST_ANGLE_DEG = 45.0
 #: smooth-union blend radius of the body's implicit primitives (metres).
 BODY_BLEND_RADIUS = 0.035
 #: width (metres) over which skinning weights blend across a joint.
-SKIN_BLEND_WIDTH = 0.06
+SKIN_BLEND_WIDTH = 0.09
 #: default number of poses in the SCAPE-like collection (the paper's SCAPE has 71).
 SCAPE_N_POSES = 71
 #: default number of frames of the jumping-jacks sequence (Vlasic's Jumping has 150).

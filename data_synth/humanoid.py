@@ -72,7 +72,7 @@ def _base_points() -> dict:
         pts[f"{s}_forearm"] = tuple(shoulder + 0.285 * d)
         pts[f"{s}_hand"] = tuple(shoulder + 0.535 * d)
         pts[f"{s}_hand_end"] = tuple(shoulder + 0.72 * d)
-        pts[f"{s}_thigh"] = (side * 0.09, 0.91, -0.01)
+        pts[f"{s}_thigh"] = (side * 0.095, 0.91, -0.01)
         pts[f"{s}_shin"] = (side * 0.105, 0.50, 0.0)
         pts[f"{s}_foot"] = (side * 0.115, 0.085, -0.025)
         pts[f"{s}_foot_end"] = (side * 0.125, 0.03, 0.16)
@@ -100,7 +100,7 @@ def _body_model() -> ImplicitModel:
     P = _base_points()
     j = NAMES.index
     prims = [
-        Ellipsoid((0.0, 0.95, -0.01), (0.165, 0.115, 0.115), j("pelvis")),
+        Ellipsoid((0.0, 0.935, -0.01), (0.165, 0.13, 0.115), j("pelvis")),
         Ellipsoid((0.0, 1.10, 0.0), (0.14, 0.13, 0.10), j("spine")),
         Ellipsoid((0.0, 1.30, -0.01), (0.165, 0.16, 0.11), j("chest")),
         Capsule((0.0, 1.44, -0.025), (0.0, 1.60, -0.01), 0.052, 0.048, j("neck")),
@@ -122,7 +122,7 @@ def _body_model() -> ImplicitModel:
             Ellipsoid(tuple(P[f"{s}_hand"] + 0.085 * d), (0.085, 0.021, 0.046), j(f"{s}_hand"),
                       axes=(tuple(d), tuple(perp), (0.0, 0.0, 1.0))),
             Ellipsoid((side * 0.075, 0.90, -0.055), (0.085, 0.09, 0.07), j("pelvis")),
-            Capsule(tuple(P[f"{s}_thigh"]), tuple(P[f"{s}_shin"]), 0.083, 0.052,
+            Capsule(tuple(P[f"{s}_thigh"]), tuple(P[f"{s}_shin"]), 0.08, 0.052,
                     j(f"{s}_thigh")),
             Capsule(tuple(P[f"{s}_shin"]), tuple(P[f"{s}_foot"] + [0, 0.02, 0]), 0.05, 0.032,
                     j(f"{s}_shin")),

@@ -13,6 +13,7 @@ Parametric meshes (the flag's sheet and the bar's tube) are built by :func:`grid
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,6 +21,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from data_synth import constants as C
+
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "Capsule",
@@ -112,12 +115,12 @@ class ImplicitModel:
         parts = np.array([prim.part for prim in self.primitives], dtype=np.int64)
         return parts[np.argmin(values, axis=1)]
 
-    def gradient(self, P: np.ndarray, h: float) -> np.ndarray:
-        """Central-difference gradient at ``P : (n, 3)`` with step ``h`` -> ``(n, 3)``."""
+    def value_and_gradient(self, P: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+        """Value ``(n,)`` and forward-difference gradient ``(n, 3)`` at ``P : (n, 3)``, step ``h``."""
         n = len(P)
-        offsets = np.vstack([np.eye(3) * h, -np.eye(3) * h])
-        values = self.evaluate((P[:, None, :] + offsets[None]).reshape(-1, 3)).reshape(n, 6)
-        return (values[:, :3] - values[:, 3:]) / (2.0 * h)
+        offsets = np.vstack([np.zeros(3), np.eye(3) * h])
+        values = self.evaluate((P[:, None, :] + offsets[None]).reshape(-1, 3)).reshape(n, 4)
+        return values[:, 0], (values[:, 1:] - values[:, :1]) / h
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Loose axis-aligned bounding box of the union, ``(lo (3,), hi (3,))``."""
@@ -192,11 +195,42 @@ def relax(V: np.ndarray, F: np.ndarray, model: ImplicitModel | None, iterations:
         move -= np.sum(move * n, axis=1, keepdims=True) * n
         V += step * move
         if model is not None:
-            for _ in range(C.REPROJECT_STEPS):
-                f = model.evaluate(V)
-                g = model.gradient(V, grad_h)
-                V -= (f / np.maximum(np.sum(g * g, axis=1), 1e-12))[:, None] * g
+            V = _project(V, model, grad_h, 1)
+    if model is not None:
+        V = _project(V, model, grad_h, C.REPROJECT_STEPS)
     return V
+
+
+def _project(V: np.ndarray, model: ImplicitModel, grad_h: float, steps: int) -> np.ndarray:
+    """Newton steps ``x -= f(x) grad f / |grad f|^2`` towards the zero set of ``model``."""
+    for _ in range(steps):
+        f, g = model.value_and_gradient(V, grad_h)
+        V = V - (f / np.maximum(np.sum(g * g, axis=1), 1e-12))[:, None] * g
+    return V
+
+
+def _sample_narrow_band(model: ImplicitModel, axes: list, spacing: float) -> np.ndarray:
+    """Implicit values on the grid ``axes`` (three 1-D coordinate arrays), exact near the surface.
+
+    The model is first sampled on every second grid point; fine points farther from the surface
+    than ``NARROW_BAND_CELLS`` coarse cells keep their nearest coarse value (only their sign
+    matters to marching cubes), the others are evaluated exactly.
+    """
+    shape = tuple(len(a) for a in axes)
+    coarse_axes = [a[::2] for a in axes]
+    coarse = model.evaluate(
+        np.stack(np.meshgrid(*coarse_axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    ).reshape(tuple(len(a) for a in coarse_axes))
+    values = coarse
+    for k in range(3):
+        values = np.repeat(values, 2, axis=k)
+    values = values[: shape[0], : shape[1], : shape[2]]
+    near = np.abs(values) < C.NARROW_BAND_CELLS * 2.0 * spacing
+    idx = np.nonzero(near)
+    points = np.stack([axes[k][idx[k]] for k in range(3)], axis=1)
+    values = values.copy()
+    values[idx] = model.evaluate(points)
+    return values
 
 
 def polygonize(model: ImplicitModel, n_vertices: int, area_estimate: float,
@@ -221,14 +255,15 @@ def polygonize(model: ImplicitModel, n_vertices: int, area_estimate: float,
     for _attempt in range(3):
         pad = C.MC_PADDING_CELLS * spacing
         axes = [np.arange(lo[k] - pad, hi[k] + pad + spacing, spacing) for k in range(3)]
-        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-        values = model.evaluate(grid).reshape(len(axes[0]), len(axes[1]), len(axes[2]))
+        values = _sample_narrow_band(model, axes, spacing)
         verts, faces, _, _ = marching_cubes(values, level=0.0, spacing=(spacing,) * 3,
                                             method="lewiner", allow_degenerate=False)
         V = verts.astype(np.float64) + np.array([a[0] for a in axes])
         F = faces.astype(np.int64)
         V, F = _largest_component(V, F)
         ratio = len(V) / n_vertices
+        logger.debug("marching cubes: spacing %.4g gave %d vertices (target %d)", spacing,
+                     len(V), n_vertices)
         if abs(ratio - 1.0) < 0.08:
             break
         spacing *= np.sqrt(ratio)
@@ -295,7 +330,7 @@ def grid_tube(n_around: int, n_along: int, length: float, radius: float) -> tupl
     d = (ri + 1) * n_around + kn
     even = ri % 2 == 0
     # even rows: the upper ring is shifted forward by half a segment
-    t1 = np.where(even[:, None], np.stack([a, c, b], 1), np.stack([a, c, d], 1))
-    t2 = np.where(even[:, None], np.stack([b, c, d], 1), np.stack([a, d, b], 1))
+    t1 = np.where(even[:, None], np.stack([a, b, c], 1), np.stack([a, d, c], 1))
+    t2 = np.where(even[:, None], np.stack([b, d, c], 1), np.stack([a, b, d], 1))
     F = np.vstack([t1, t2]).astype(np.int64)
     return V, F

@@ -130,7 +130,7 @@ def jumping_jacks(phase, rng):
     up = rng.uniform(0.95, 1.05)
     p = Pose.identity(n)
     for side in ("l", "r"):
-        p.arm(side, lower=0.7 - up * 2.95 * s, shrug=0.3 * s, elbow=0.15 + 0.1 * s,
+        p.arm(side, lower=0.7 - up * 2.75 * s, shrug=0.55 * s, elbow=0.15 + 0.1 * s,
               forward=0.1 * (1 - s))
         p.leg(side, spread=0.06 + 0.24 * s, knee=0.3 * (1 - np.abs(np.sin(phi))), hip=0.15 * (1 - np.abs(np.sin(phi))),
               ankle=0.35 * np.abs(np.sin(phi)))

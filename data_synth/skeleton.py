@@ -66,13 +66,20 @@ class Skeleton:
         except ValueError:
             raise ValueError(f"no joint named {name!r}; joints are {list(self.names)}") from None
 
-    def neighbours(self) -> list[set]:
-        """For each joint the set of joints within one step in the tree (itself included)."""
+    def relatives(self, depth: int = 1) -> list[set]:
+        """For each joint: itself, its ancestors and descendants up to ``depth`` generations.
+
+        Siblings (say the two thighs) are never relatives, so their weights never mix.
+        """
         out = [{j} for j in range(self.n_joints)]
-        for j, p in enumerate(self.parents):
-            if p >= 0:
-                out[j].add(int(p))
-                out[int(p)].add(j)
+        for j in range(self.n_joints):
+            a = j
+            for _ in range(depth):
+                a = int(self.parents[a])
+                if a < 0:
+                    break
+                out[j].add(a)
+                out[a].add(j)
         return out
 
 

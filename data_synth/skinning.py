@@ -2,8 +2,8 @@
 
 Weights start from each vertex's *part* (the bone of the implicit primitive that made the surface
 there), are diffused over the mesh (so they blend smoothly across joints, over a width given in
-metres) and are then restricted to the part's neighbouring bones, so an arm never pulls the
-torso's far side. Posing uses dual-quaternion skinning (Kavan et al. 2007), which does not
+metres) and are then restricted to the part's relatives (ancestors and descendants up to two
+generations, never siblings), so one thigh never pulls the other. Posing uses dual-quaternion skinning (Kavan et al. 2007), which does not
 collapse a twisting wrist or a raised shoulder the way linear blend skinning does ("candy
 wrapper"); :func:`linear_blend` is kept for affine maps (body-shape changes) and for comparison.
 """
@@ -47,7 +47,7 @@ def skinning_weights(V: np.ndarray, F: np.ndarray, parts: np.ndarray, skeleton: 
     for _ in range(iterations):
         W = 0.5 * W + 0.5 * (A @ W) / deg[:, None]
     allowed = np.zeros((J, J), dtype=bool)
-    for j, nb in enumerate(skeleton.neighbours()):
+    for j, nb in enumerate(skeleton.relatives(depth=2)):
         allowed[j, list(nb)] = True
     W *= allowed[parts]
     if max_influences < J:

@@ -1,0 +1,206 @@
+"""Geometry of every synthetic collection: closed/manifold templates, no degenerate or inverted
+triangles in any frame, edge lengths within bounds of the rest pose, and the bar's twist."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial.transform import Rotation
+
+from data_synth import constants as C
+from data_synth import list_collections, make_collection
+from meshvae_lib.topology import boundary_loops, edges
+
+NAMES = [n for n, _ in list_collections()]
+CLOSED = {"scape", "dyna", "jumping", "hand", "face"}
+#: boundary loops expected of each collection's template
+N_LOOPS = {"flag": 1, "bar": 2, **{n: 0 for n in CLOSED}}
+
+
+@pytest.fixture(scope="module")
+def collections():
+    return {name: make_collection(name, seed=0) for name in NAMES}
+
+
+def rest_per_mesh(col) -> np.ndarray:
+    """``(N, V, 3)``: each mesh's own rest pose (a Dyna mesh's body shape in the rest pose)."""
+    if "shape_rest" in col.extras:
+        idx = [col.extras["shape_names"].index(s) for s in col.labels["shape"]]
+        return col.extras["shape_rest"][idx]
+    return np.broadcast_to(col.extras["rest"], col.vertices.shape)
+
+
+def _single_fans(F: np.ndarray, n_vertices: int) -> bool:
+    """True if the faces around every vertex are connected through shared edges (one fan)."""
+    import scipy.sparse as sp
+
+    n_f = len(F)
+    corner_v = F.reshape(-1)
+    corner_f = np.repeat(np.arange(n_f), 3)
+    # two corners of the same vertex are linked if their faces share an edge through that vertex
+    half = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
+    und = np.sort(half, axis=1)
+    order = np.lexsort((und[:, 1], und[:, 0]))
+    u = und[order]
+    same = np.all(u[1:] == u[:-1], axis=1)
+    fa = corner_f[order[:-1][same]]
+    fb = corner_f[order[1:][same]]
+    ends = u[:-1][same]  # each shared edge links its two faces at both of its end vertices
+    key_a = np.concatenate([fa * n_vertices + ends[:, 0], fa * n_vertices + ends[:, 1]])
+    key_b = np.concatenate([fb * n_vertices + ends[:, 0], fb * n_vertices + ends[:, 1]])
+    keys = corner_f * n_vertices + corner_v
+    index = {k: i for i, k in enumerate(keys.tolist())}
+    ia = np.array([index[k] for k in key_a.tolist()])
+    ib = np.array([index[k] for k in key_b.tolist()])
+    G = sp.coo_matrix((np.ones(len(ia)), (ia, ib)), shape=(3 * n_f, 3 * n_f))
+    _, comp = connected_components(G, directed=False)
+    fans_per_vertex = np.zeros(n_vertices, dtype=np.int64)
+    np.add.at(fans_per_vertex, corner_v, 0)
+    first = np.unique(np.stack([corner_v, comp], 1), axis=0)
+    np.add.at(fans_per_vertex, first[:, 0], 1)
+    return bool((fans_per_vertex == 1).all())
+
+
+def _cross(V, F):
+    return np.cross(V[..., F[:, 1], :] - V[..., F[:, 0], :], V[..., F[:, 2], :] - V[..., F[:, 0], :])
+
+
+def patches(F: np.ndarray) -> np.ndarray:
+    """``(n_faces, 6)``: each face's corners and the far corners of its edge neighbours (its own
+    corner repeated at a boundary edge)."""
+    half = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)  # edge k of face f
+    opposite = np.roll(F, 1, axis=1).reshape(-1)  # corner across edge k inside face f
+    key = {}
+    for h, (a, b) in enumerate(half.tolist()):  # test helper, built once per template
+        key[(a, b)] = h
+    twin_apex = np.array([opposite[key[(b, a)]] if (b, a) in key else opposite[h]
+                          for h, (a, b) in enumerate(half.tolist())]).reshape(-1, 3)
+    return np.hstack([F, twin_apex])
+
+
+def local_normal_turn_deg(rest: np.ndarray, V: np.ndarray, F: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Angle (degrees) between each deformed face normal and its rest normal carried along by
+    the best rigid rotation of the face's 6-vertex patch (Kabsch). ``(N, n_faces)``.
+
+    The patch rotation removes the legitimate large rotations of a limb or a flag; what is left
+    is how far the triangle turned against its neighbourhood, which passes 90 degrees only when
+    the triangle folds over (is inverted).
+    """
+    X0 = rest[..., P, :] - rest[..., P, :].mean(axis=-2, keepdims=True)
+    X = V[:, P, :] - V[:, P, :].mean(axis=-2, keepdims=True)
+    H = np.einsum("...pi,...pj->...ij", X0, X)
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(np.einsum("...ij,...jk->...ik", U, Vt)))
+    U[..., :, 2] *= d[..., None]
+    R = np.einsum("...ij,...jk->...ki", U, Vt)  # maps rest to deformed
+    n0 = _cross(rest, F)
+    n = _cross(V, F)
+    n0r = np.einsum("...ij,...j->...i", R, n0)
+    cos = np.sum(n * n0r, -1) / (np.linalg.norm(n, axis=-1) * np.linalg.norm(n0r, axis=-1))
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_template_topology(collections, name):
+    col = collections[name]
+    V0, F = col.extras["rest"], col.faces
+    assert F.dtype == np.int64 and F.min() == 0 and F.max() == V0.shape[0] - 1
+    assert col.vertices.dtype == np.float64 and np.isfinite(col.vertices).all()
+    # every vertex used, one connected piece
+    A = trimesh.Trimesh(V0, F, process=False)
+    n_comp, _ = connected_components(A.edges_sparse, directed=False)
+    assert n_comp == 1
+    assert len(np.unique(F)) == len(V0)
+    # edge-manifold: no edge has more than two faces, orientation consistent
+    assert A.is_winding_consistent
+    loops = boundary_loops(F)
+    assert len(loops) == N_LOOPS[name], f"{name}: {len(loops)} boundary loops"
+    if name in CLOSED:
+        assert A.is_watertight
+        assert A.euler_number == 2  # a sphere-like closed surface
+        assert A.volume > 0  # counter-clockwise seen from outside
+    # vertex-manifold: the faces around every vertex form one fan; then V - E + F equals
+    # 2 - (number of boundary loops) for these genus-0 surfaces, and a pinched vertex breaks it
+    assert len(V0) - len(edges(F)) + len(F) == 2 - len(loops)
+    assert _single_fans(F, len(V0))
+    ang = np.degrees(A.face_angles)
+    assert ang.min() > C.MIN_TEMPLATE_ANGLE_DEG, f"{name}: smallest angle {ang.min():.1f}"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_no_degenerate_or_inverted_triangles(collections, name):
+    col = collections[name]
+    F = col.faces
+    rest = rest_per_mesh(col)
+    area0 = np.linalg.norm(_cross(rest, F), axis=-1)
+    ratio = np.linalg.norm(_cross(col.vertices, F), axis=-1) / area0
+    assert ratio.min() > C.MIN_AREA_RATIO, f"{name}: area ratio {ratio.min():.4f}"
+    assert ratio.max() < C.MAX_AREA_RATIO, f"{name}: area ratio {ratio.max():.2f}"
+    turn = local_normal_turn_deg(rest, col.vertices, F, patches(F))
+    assert turn.max() < C.MAX_LOCAL_NORMAL_TURN_DEG, f"{name}: a triangle turned {turn.max():.0f} deg"
+    if name in CLOSED:  # and the surface as a whole keeps its outward orientation
+        vol = np.einsum("nfi,nfi->nf", col.vertices[:, F[:, 0]],
+                        np.cross(col.vertices[:, F[:, 1]], col.vertices[:, F[:, 2]])).sum(1) / 6
+        assert (vol > 0.5 * vol[0]).all()
+
+
+def test_normal_turn_detects_an_inverted_triangle(collections):
+    """The check above can fail: pushing one vertex through the surface is caught."""
+    col = collections["flag"]
+    F, rest = col.faces, col.extras["rest"]
+    V = rest.copy()
+    v = F[len(F) // 2, 0]
+    nbrs = np.unique(F[(F == v).any(1)])
+    V[v, :2] = 2 * V[nbrs[nbrs != v], :2].mean(0) - V[v, :2]  # reflect through its ring centre
+    V[v, :2] += 3 * (V[nbrs[nbrs != v], :2].mean(0) - rest[v, :2])
+    turn = local_normal_turn_deg(rest[None], V[None], F, patches(F))
+    assert turn.max() > C.MAX_LOCAL_NORMAL_TURN_DEG
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_edge_lengths_stay_near_rest(collections, name):
+    col = collections[name]
+    E = edges(col.faces)
+    rest = rest_per_mesh(col)
+    l0 = np.linalg.norm(rest[:, E[:, 0]] - rest[:, E[:, 1]], axis=-1)
+    ratio = np.linalg.norm(col.vertices[:, E[:, 0]] - col.vertices[:, E[:, 1]], axis=-1) / l0
+    assert ratio.min() > C.MIN_EDGE_RATIO, f"{name}: edge shrank to {ratio.min():.3f}"
+    assert ratio.max() < C.MAX_EDGE_RATIO, f"{name}: edge grew to {ratio.max():.2f}"
+    # and the meshes really move: the collection is not a copy of its rest pose
+    assert np.abs(col.vertices - rest).max() > 0.05 * np.ptp(rest[0], axis=0).max()
+
+
+def _ring_rotations(col, frame):
+    """Rotation of every ring of the bar from the rest pose, ``(n_along,)`` Rotation."""
+    n_along, n_around = col.extras["tube_shape"]
+    X0 = col.extras["rest"].reshape(n_along, n_around, 3)
+    X = col.vertices[frame].reshape(n_along, n_around, 3)
+    X0 = X0 - X0.mean(1, keepdims=True)
+    X = X - X.mean(1, keepdims=True)
+    H = np.einsum("rpi,rpj->rij", X0, X)
+    U, _, Vt = np.linalg.svd(H)
+    return Rotation.from_matrix(np.einsum("rij,rjk->rki", U, Vt))
+
+
+def test_bar_ends_rotate_past_180_degrees(collections):
+    col = collections["bar"]
+    for motion in ("twist", "bend", "twist_bend"):
+        idx = np.nonzero(col.labels["motion"] == motion)[0]
+        last = idx[np.argmax(col.labels["frame"][idx])]
+        rings = _ring_rotations(col, last)
+        steps = rings[1:] * rings[:-1].inv()  # ring to ring, each small
+        step_angles = steps.magnitude()
+        assert step_angles.max() < np.deg2rad(20)
+        accumulated = np.rad2deg(step_angles.sum())
+        # the end-to-end rotation is the accumulated one modulo 360 degrees
+        end_to_end = np.rad2deg((rings[-1] * rings[0].inv()).magnitude())
+        expected = np.hypot(col.labels["twist_deg"][last], col.labels["bend_deg"][last])
+        assert accumulated > 180.0, f"{motion}: ends turned only {accumulated:.0f} deg"
+        if motion != "twist_bend":  # one fixed axis: the angles simply add up
+            assert abs(accumulated - expected) < 0.02 * expected
+            assert abs(min(accumulated % 360, 360 - accumulated % 360) - end_to_end) < 1.0
+        # the first frame is the straight, untwisted bar
+        first = idx[np.argmin(col.labels["frame"][idx])]
+        assert _ring_rotations(col, first).magnitude().max() < 1e-9
