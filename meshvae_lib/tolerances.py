@@ -115,3 +115,8 @@ DEFAULT_EPOCHS = 1000
 DEFAULT_BATCH_SIZE = 32
 #: internal layer sizes for the coordinate baselines of Table 3 (RIMD uses none).
 HIDDEN_COORDS = (512,)
+
+# --- viewing (meshvae_lib.viewing) -----------------------------------------------------------
+#: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
+#: takes less than this many milliseconds; slower models switch to decoding on release.
+LIVE_UPDATE_MAX_MS = 150.0
