@@ -172,3 +172,11 @@ def test_static_view_is_a_png_and_updates_its_display_handle(sphere):
     assert len(view._handle.updates) == 1 and view._handle.updates[0]["image/png"] == view.png
     with pytest.raises(ValueError, match="'threejs'"):
         ImageView([V], F, mode="threejs")
+
+
+def test_grid_figure_shows_as_png_without_pyplot(sphere):
+    V, F = sphere
+    fig = render_mesh_grid(V, F, size=1.0, dpi=40)
+    png = fig._repr_png_()
+    assert png[:4] == b"\x89PNG"
+    assert _png_pixels(png).shape[:2] == (40, 40)

@@ -127,3 +127,16 @@ def test_as_mesh_stack_forms(sphere):
     assert as_mesh_stack(np.stack([V, V, V])).shape == (3, len(V), 3)
     with pytest.raises(ValueError, match=r"\(2, 3, 4\)"):
         as_mesh_stack(np.zeros((2, 3, 4)))
+
+
+def test_snapshot_png_in_display_data_and_current_figure(sphere):
+    V, F = sphere
+    v = MeshViewer([V, V], F, titles=["a", "b"], mode="threejs")
+    bundle = v._repr_mimebundle_()
+    assert bundle["image/png"][:4] == b"\x89PNG"
+    assert "image/png" not in MeshViewer(V, F, mode="threejs", snapshot=False)._repr_mimebundle_()
+    v.update([V, V * [3.0, 1.0, 1.0]])
+    fig = v.figure(size=1.5, dpi=40)
+    assert [ax.get_title() for ax in fig.axes] == ["a", "b"]
+    spans = [ax.collections[0].get_datalim(ax.transData).width for ax in fig.axes]
+    assert spans[1] > 2.0 * spans[0]  # the figure shows the updated, stretched mesh

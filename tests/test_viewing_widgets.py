@@ -3,6 +3,8 @@ interpolation slider. Each check goes through the widgets' own traits, as a brow
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import trimesh
@@ -196,3 +198,31 @@ def test_interpolation_slider_with_a_custom_path(sphere):
     s.slider.value = 0.5
     assert seen[-1] == 0.5 and s.viewer.n_meshes == 1
     np.testing.assert_allclose(s.viewer.positions[0], 1.5 * V, atol=1e-6)
+
+
+def test_slow_decoder_switches_sliders_to_update_on_release(sphere, monkeypatch):
+    V, F = sphere
+    import meshvae_lib.viewing.widgets as widgets
+
+    monkeypatch.setattr(widgets, "LIVE_UPDATE_MAX_MS", 5.0)
+
+    def slow(z):
+        time.sleep(0.02)
+        return V * (1.0 + 0.1 * z[0])
+
+    e = LatentExplorer(slow, 2, F, mode="threejs")
+    assert e.live
+    e.sliders[0].value = 0.5
+    e.sliders[0].value = 1.0
+    assert e.live  # two samples are not enough to judge
+    e.sliders[0].value = 1.5
+    assert not e.live and all(not s.continuous_update for s in e.sliders.values())
+    assert "updates on release" in e.status.value
+    fast = LatentExplorer(lambda z: V, 2, F, mode="threejs")
+    for v in (0.5, 1.0, 1.5, 2.0):
+        fast.sliders[1].value = v
+    assert fast.live
+    fixed = LatentExplorer(slow, 2, F, continuous_update=True, mode="threejs")
+    for v in (0.5, 1.0, 1.5):
+        fixed.sliders[0].value = v
+    assert fixed.live  # an explicit choice is kept

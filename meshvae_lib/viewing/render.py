@@ -14,16 +14,28 @@ import io
 import math
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from ..topology import face_normals
 from .buffers import check_vertices, color_buffer
 from .colors import DEFAULT_MESH_COLOR, ColorMapping
 
-__all__ = ["view_basis", "project", "shade", "render_mesh", "render_mesh_grid", "figure_to_png"]
+__all__ = ["MeshFigure", "view_basis", "project", "shade", "render_mesh", "render_mesh_grid", "figure_to_png"]
 
 #: default view (elevation, azimuth) in degrees: slightly from above and from the front-right.
 DEFAULT_VIEW = (15.0, 30.0)
 _UP_AXES = {"y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+class MeshFigure(Figure):
+    """A matplotlib Figure that Jupyter shows as a PNG even when pyplot was never imported.
+
+    Figures made without pyplot have no PNG formatter until the inline backend is loaded, so a
+    cell ending in ``fig`` would show only ``<Figure size ...>``; ``_repr_png_`` fixes that.
+    """
+
+    def _repr_png_(self):
+        return figure_to_png(self)
 
 
 def view_basis(view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
@@ -259,12 +271,10 @@ def render_mesh_grid(
 
     Returns
     -------
-    fig : matplotlib.figure.Figure
-        Not registered with pyplot: display it (Jupyter shows it as the cell's result) or save it
-        with ``fig.savefig``; :func:`figure_to_png` gives the PNG bytes.
+    fig : MeshFigure (a matplotlib.figure.Figure)
+        Not registered with pyplot: display it (Jupyter shows it as the cell's result, as a PNG) or
+        save it with ``fig.savefig``; :func:`figure_to_png` gives the PNG bytes.
     """
-    from matplotlib.figure import Figure
-
     Vs = _as_mesh_list(meshes)
     k = len(Vs)
     if ncols < 1:
@@ -276,7 +286,7 @@ def render_mesh_grid(
     nr = int(math.ceil(k / nc))
     extra = 0.7 if (colorbar is not None or legend) else 0.0
     top = (0.35 if suptitle else 0.0) + (0.25 if titles is not None else 0.0)
-    fig = Figure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
+    fig = MeshFigure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
     R = view_basis(view, up)
     extent = None
     if same_scale:

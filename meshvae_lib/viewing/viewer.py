@@ -91,6 +91,10 @@ class MeshViewer:
         Material options.
     mode : {"auto", "threejs", "image", "static"}
         How to display (see :func:`~meshvae_lib.viewing.fallback.resolve_mode`).
+    snapshot : bool
+        In "threejs" mode, also put a small matplotlib PNG of the initial state into the display
+        data. JupyterLab shows the live 3D view; exports without widget state (nbconvert HTML,
+        GitHub) and untrusted notebooks show the PNG instead of an empty widget.
 
     Attributes
     ----------
@@ -110,7 +114,7 @@ class MeshViewer:
     def __init__(self, V, F, colors=None, values=None, cmap: str = "viridis", vmin=None, vmax=None,
                  value_label: str = "", labels=None, titles=None, width: int = 720, height: int = 400,
                  gap: float = 0.25, background: str = "#ffffff", flat_shading: bool = False,
-                 wireframe: bool = False, mode: str = "auto"):
+                 wireframe: bool = False, mode: str = "auto", snapshot: bool = True):
         Vs = as_mesh_stack(V)
         self.n_meshes, self.n_vertices = Vs.shape[0], Vs.shape[1]
         self.F = np.asarray(F).astype(np.int64)
@@ -122,6 +126,7 @@ class MeshViewer:
         self.titles = None if titles is None else [str(t) for t in titles]
         self.width, self.height = int(width), int(height)
         self.mode = resolve_mode(mode)
+        self.snapshot = bool(snapshot)
         self.n_updates = 0
         self.last_update_ms = float("nan")
         self.mapping: ColorMapping | None = None
@@ -285,6 +290,32 @@ class MeshViewer:
         self.n_updates += 1
         self.last_update_ms = 1e3 * (time.perf_counter() - t0)
 
+    # -- static copies ---------------------------------------------------------------------------
+    def figure(self, **render_kw):
+        """The current state as a matplotlib figure (to save what the view shows).
+
+        Parameters
+        ----------
+        **render_kw
+            Passed to :func:`~meshvae_lib.viewing.render.render_mesh_grid` (``view``, ``size``,
+            ``dpi``, ``ncols``...).
+
+        Returns
+        -------
+        fig : MeshFigure
+        """
+        from .render import render_mesh_grid
+
+        render_kw.setdefault("ncols", self.n_meshes)
+        return render_mesh_grid([p.astype(np.float64) for p in self.positions], self.F, titles=self.titles,
+                                colors=self._colors, colorbar=self.mapping, legend=self.legend, **render_kw)
+
+    def snapshot_png(self, size: float = 2.2, dpi: int = 60) -> bytes:
+        """A small PNG of the current state: ``bytes``."""
+        from .render import figure_to_png
+
+        return figure_to_png(self.figure(size=size, dpi=dpi))
+
     # -- display -------------------------------------------------------------------------------
     def __repr__(self) -> str:
         return f"MeshViewer({self.n_meshes} mesh{'es' if self.n_meshes != 1 else ''} x {self.n_vertices} vertices, mode={self.mode!r})"
@@ -293,6 +324,8 @@ class MeshViewer:
         if self.widget is not None:
             data = self.widget._repr_mimebundle_()
             data["text/plain"] = repr(self)
+            if self.mode == "threejs" and self.snapshot:
+                data["image/png"] = self.snapshot_png()
             return data
         return {"image/png": self._image.png, "text/plain": repr(self)}
 

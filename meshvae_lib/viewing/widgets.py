@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from ..tolerances import LIVE_UPDATE_MAX_MS
 from .viewer import MeshViewer, as_mesh_stack
 
 __all__ = ["FramePlayer", "LatentPad", "LatentExplorer", "InterpolationSlider"]
@@ -35,6 +36,8 @@ class _Displayable:
             return self.viewer._repr_mimebundle_()
         data = self.widget._repr_mimebundle_()
         data["text/plain"] = repr(self)
+        if self.viewer.mode == "threejs" and self.viewer.snapshot:
+            data["image/png"] = self.viewer.snapshot_png()
         return data
 
     def _ipython_display_(self):
@@ -256,8 +259,11 @@ class LatentExplorer(_Displayable):
     color_by : {None, "displacement"}
         ``"displacement"`` colours each vertex by its distance to the mesh decoded at ``z0`` (with a
         colour bar), showing which parts the moved dimensions control.
-    continuous_update : bool
-        Decode while a slider is dragged (True) or on release.
+    continuous_update : bool or "auto"
+        Decode while a slider is dragged (True) or on release (False). ``"auto"`` (default) starts
+        continuous and switches to on-release when the median of the last three updates exceeds
+        :data:`~meshvae_lib.tolerances.LIVE_UPDATE_MAX_MS`, so a slow model does not build a
+        backlog of stale slider positions.
     titles : list of str, optional
     **viewer_kw
         Passed to :class:`MeshViewer` (``width``, ``height``, ``mode``, ...).
@@ -274,7 +280,7 @@ class LatentExplorer(_Displayable):
 
     def __init__(self, decode, latent_dim: int, F, dims=None, z0=None, value_range=(-3.0, 3.0),
                  step: float = 0.05, pad_dims="auto", pad_event: str = "click", seed: int = 0,
-                 random_scale: float = 1.0, reference=None, color_by=None, continuous_update: bool = True,
+                 random_scale: float = 1.0, reference=None, color_by=None, continuous_update="auto",
                  titles=None, **viewer_kw):
         import ipywidgets as W
 
@@ -305,6 +311,10 @@ class LatentExplorer(_Displayable):
         self.n_decodes = 0
         self.last_update_ms = float("nan")
         self._suspended = False
+        if continuous_update not in (True, False, "auto"):
+            raise ValueError(f"continuous_update must be True, False or 'auto', got {continuous_update!r}")
+        self._auto_live = continuous_update == "auto"
+        self._recent_ms: list[float] = []
 
         meshes = self._decode_meshes(self._z)
         self._base = meshes.copy()
@@ -322,7 +332,8 @@ class LatentExplorer(_Displayable):
         self.sliders = {}
         for d in dims:
             s = W.FloatSlider(value=float(np.clip(self._z[d], lo, hi)), min=lo, max=hi, step=step,
-                              description=f"z[{d}]", continuous_update=continuous_update, readout_format=".2f")
+                              description=f"z[{d}]", continuous_update=bool(continuous_update),
+                              readout_format=".2f")
             s.observe(lambda change, d=d: self._on_slider(d, change), names="value")
             self.sliders[d] = s
         self.reset_button = W.Button(description="reset", icon="undo", tooltip="back to z0")
@@ -385,11 +396,29 @@ class LatentExplorer(_Displayable):
             self.viewer.set_colors(values=disp, cmap="YlOrRd", vmin=0.0,
                                    vmax=max(float(disp.max()), 1e-12), value_label="displacement")
         self.last_update_ms = 1e3 * (time.perf_counter() - t0)
+        self._adapt_live_updates()
         self._refresh_status()
+
+    @property
+    def live(self) -> bool:
+        """Whether the sliders decode while dragged (``continuous_update``)."""
+        return bool(next(iter(self.sliders.values())).continuous_update)
+
+    def _adapt_live_updates(self):
+        if not self._auto_live:
+            return
+        self._recent_ms = (self._recent_ms + [self.last_update_ms])[-3:]
+        if len(self._recent_ms) == 3 and self.live and float(np.median(self._recent_ms)) > LIVE_UPDATE_MAX_MS:
+            for s in self.sliders.values():
+                s.continuous_update = False
+            log.info("decoding takes %.0f ms per update; sliders now decode on release",
+                     float(np.median(self._recent_ms)))
 
     def _refresh_status(self):
         if hasattr(self, "status"):
             ms = "" if np.isnan(self.last_update_ms) else f" &middot; {self.last_update_ms:.0f} ms"
+            if not self.live:
+                ms += " &middot; updates on release"
             self.status.value = f"<span style='font-size:12px'>|z| = {np.linalg.norm(self._z):.2f}{ms}</span>"
 
     def _on_slider(self, d: int, change):
