@@ -31,11 +31,13 @@ MIN_AREA_RATIO = 0.05
 #: and at most this multiple of it.
 MAX_AREA_RATIO = 8.0
 #: every edge keeps its length within [MIN_EDGE_RATIO, MAX_EDGE_RATIO] x its rest length.
-MIN_EDGE_RATIO = 0.2
-MAX_EDGE_RATIO = 4.0
-#: a deformed face normal may turn at most this far (degrees) from its rest normal after the
-#: rest-to-frame rotation of its neighbourhood is removed; see docs/data_synth.md.
-MAX_LOCAL_NORMAL_TURN_DEG = 100.0
+MIN_EDGE_RATIO = 0.08
+MAX_EDGE_RATIO = 5.0
+#: the normals of two triangles sharing an edge differ by less than this (degrees) in every
+#: frame: a larger angle means a triangle folded over (inverted) or a pinched crease.
+MAX_FOLD_ANGLE_DEG = 150.0
+#: and less than this in the rest pose (thin parts such as fingertips make sharper creases).
+MAX_TEMPLATE_FOLD_DEG = 140.0
 #: smallest interior angle (degrees) of any template triangle.
 MIN_TEMPLATE_ANGLE_DEG = 10.0
 
@@ -49,7 +51,7 @@ ARM_REST_ANGLE_DEG = 45.0
 #: smooth-union blend radius of the body's implicit primitives (metres).
 BODY_BLEND_RADIUS = 0.035
 #: width (metres) over which skinning weights blend across a joint.
-SKIN_BLEND_WIDTH = 0.09
+SKIN_BLEND_WIDTH = 0.12
 #: default number of poses in the SCAPE-like collection (the paper's SCAPE has 71).
 SCAPE_N_POSES = 71
 #: default number of frames of the jumping-jacks sequence (Vlasic's Jumping has 150).
@@ -60,7 +62,7 @@ DYNA_FRAMES_PER_MOTION = 6
 # --- hand and face ----------------------------------------------------------------------------
 HAND_DEFAULT_RESOLUTION = 1800
 HAND_BLEND_RADIUS = 0.006
-HAND_SKIN_BLEND_WIDTH = 0.012
+HAND_SKIN_BLEND_WIDTH = 0.016
 FACE_DEFAULT_RESOLUTION = 2000
 FACE_BLEND_RADIUS = 0.02
 

@@ -51,11 +51,11 @@ def _face_model() -> ImplicitModel:
         Capsule((0.0, -0.06, -0.025), (0.0, -0.17, -0.03), 0.05, 0.052, 0),  # neck
     ]
     carve = [
-        Ellipsoid((0.0, -0.044, 0.103), (0.027, 0.0022, 0.016), 0),  # mouth line
+        Ellipsoid((0.0, -0.044, 0.104), (0.026, 0.0035, 0.016), 0),  # mouth line
         Ellipsoid((0.032, 0.02, 0.096), (0.016, 0.009, 0.012), 0),  # eye sockets
         Ellipsoid((-0.032, 0.02, 0.096), (0.016, 0.009, 0.012), 0),
     ]
-    return ImplicitModel(prims, blend=C.FACE_BLEND_RADIUS, subtract=carve, subtract_blend=0.006)
+    return ImplicitModel(prims, blend=C.FACE_BLEND_RADIUS, subtract=carve, subtract_blend=0.008)
 
 
 @functools.lru_cache(maxsize=4)

@@ -40,8 +40,8 @@ GESTURES = {
 def _layout():
     """Joint names, parents, rest positions and bone directions of the hand."""
     names, parents, rest, dirs = ["forearm", "palm"], [-1, 0], [(0, -0.06, 0), (0, 0, 0)], [_Y, _Y]
-    bases = {"index": (0.03, 0.092, 0.0), "middle": (0.01, 0.097, 0.0),
-             "ring": (-0.01, 0.093, 0.0), "little": (-0.03, 0.083, 0.0)}
+    bases = {"index": (0.033, 0.092, 0.0), "middle": (0.011, 0.097, 0.0),
+             "ring": (-0.011, 0.093, 0.0), "little": (-0.033, 0.083, 0.0)}
     lengths = {"index": (0.043, 0.026, 0.021), "middle": (0.047, 0.029, 0.022),
                "ring": (0.044, 0.028, 0.021), "little": (0.035, 0.021, 0.019)}
     splay = {"index": 0.12, "middle": 0.0, "ring": -0.1, "little": -0.22}
@@ -71,7 +71,7 @@ def _layout():
 def _hand_model(names, rest, dirs, tips) -> ImplicitModel:
     prims = [
         Capsule((0.0, -0.07, 0.0), (0.0, 0.0, 0.0), 0.022, 0.024, 0),
-        Ellipsoid((0.0, 0.048, 0.0), (0.043, 0.055, 0.0155), 1),
+        Ellipsoid((0.0, 0.048, 0.0), (0.045, 0.055, 0.0155), 1),
         Ellipsoid((0.018, 0.03, 0.006), (0.02, 0.03, 0.014), 1),  # thenar eminence
     ]
     radius = {"thumb": (0.0115, 0.0095, 0.0085), "index": (0.0086, 0.0078, 0.007),
@@ -115,7 +115,7 @@ def _gesture_rotations(skeleton, dirs, curls, spread, wrist, amount) -> np.ndarr
     n = len(amount)
     local = np.broadcast_to(np.eye(3), (n, skeleton.n_joints, 3, 3)).copy()
     local[:, 1] = axis_rotation(_X, wrist * amount)
-    flex = (1.35, 1.55, 1.0)  # maximum flexion of the three joints, radians
+    flex = (1.25, 1.45, 0.95)  # maximum flexion of the three joints, radians
     spread_angle = {"index": 0.12, "middle": 0.0, "ring": -0.1, "little": -0.22, "thumb": 0.3}
     thumb_target = np.array([-0.7, 0.0, 1.0])
     for f, finger in enumerate(FINGERS):

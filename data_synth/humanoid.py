@@ -72,7 +72,7 @@ def _base_points() -> dict:
         pts[f"{s}_forearm"] = tuple(shoulder + 0.285 * d)
         pts[f"{s}_hand"] = tuple(shoulder + 0.535 * d)
         pts[f"{s}_hand_end"] = tuple(shoulder + 0.72 * d)
-        pts[f"{s}_thigh"] = (side * 0.095, 0.91, -0.01)
+        pts[f"{s}_thigh"] = (side * 0.1, 0.91, -0.01)
         pts[f"{s}_shin"] = (side * 0.105, 0.50, 0.0)
         pts[f"{s}_foot"] = (side * 0.115, 0.085, -0.025)
         pts[f"{s}_foot_end"] = (side * 0.125, 0.03, 0.16)
@@ -119,10 +119,10 @@ def _body_model() -> ImplicitModel:
                     j(f"{s}_upperarm")),
             Capsule(tuple(P[f"{s}_forearm"]), tuple(P[f"{s}_hand"]), 0.038, 0.027,
                     j(f"{s}_forearm")),
-            Ellipsoid(tuple(P[f"{s}_hand"] + 0.085 * d), (0.085, 0.021, 0.046), j(f"{s}_hand"),
+            Ellipsoid(tuple(P[f"{s}_hand"] + 0.085 * d), (0.085, 0.028, 0.046), j(f"{s}_hand"),
                       axes=(tuple(d), tuple(perp), (0.0, 0.0, 1.0))),
             Ellipsoid((side * 0.075, 0.90, -0.055), (0.085, 0.09, 0.07), j("pelvis")),
-            Capsule(tuple(P[f"{s}_thigh"]), tuple(P[f"{s}_shin"]), 0.08, 0.052,
+            Capsule(tuple(P[f"{s}_thigh"]), tuple(P[f"{s}_shin"]), 0.076, 0.052,
                     j(f"{s}_thigh")),
             Capsule(tuple(P[f"{s}_shin"]), tuple(P[f"{s}_foot"] + [0, 0.02, 0]), 0.05, 0.032,
                     j(f"{s}_shin")),
@@ -242,10 +242,11 @@ def shape_body(template: BodyTemplate, shape: BodyShape) -> tuple[np.ndarray, np
     for s in "lr":
         for n in ("forearm", "hand", "hand_end"):
             seg[f"{s}_{n}"] = shape.arm_length
-        seg[f"{s}_upperarm"] = shape.shoulder_width * (0.92 if female else 1.0)
+        # shoulders and hips move out with the torso's girth, so arms and legs stay clear of it
+        seg[f"{s}_upperarm"] = shape.shoulder_width * (0.92 if female else 1.0) * g**0.7
         for n in ("shin", "foot"):
             seg[f"{s}_{n}"] = shape.leg_length
-        seg[f"{s}_thigh"] = 1.12 if female else 1.0  # hip joints further apart
+        seg[f"{s}_thigh"] = (1.12 if female else 1.0) * g**0.5  # hip joints further apart
     new = {"pelvis": pts["pelvis"] * scale}
     parent_of = dict(JOINTS)
     parent_of.update({v: k for k, v in BONE_END.items() if v.endswith("_end")})

@@ -150,8 +150,8 @@ def punch(phase, rng):
     ext *= rng.uniform(0.9, 1.0)
     for side, idx in (("l", 0), ("r", 1)):
         e = np.where(which == idx, ext, 0.0)
-        p.arm(side, lower=0.95 - 0.2 * e, forward=1.0 + 0.55 * e, twist=0.3,
-              elbow=2.2 * (1 - e) + 0.05)
+        p.arm(side, lower=0.5 - 0.05 * e, forward=0.9 + 0.6 * e, twist=0.0, shrug=0.15,
+              elbow=1.9 * (1 - e) + 0.1)
     twist = 0.35 * np.where(which == 0, -ext, ext)
     p.trunk(twist=twist, bend=0.1)
     p.leg("l", hip=0.35, knee=0.35, ankle=-0.1)
@@ -166,10 +166,11 @@ def squat(phase, rng):
     depth = rng.uniform(0.9, 1.05)
     s = depth * (0.5 - 0.5 * np.cos(2.0 * np.pi * 1.5 * phase))
     p = Pose.identity(n)
-    pitch = 0.45 * s
+    pitch = 0.4 * s
     for side in ("l", "r"):
-        p.leg(side, hip=1.35 * s + pitch, knee=1.9 * s, ankle=-0.55 * s, spread=0.08 * s)
-        p.arm(side, lower=0.75 - 0.1 * s, forward=1.35 * s, elbow=0.2 * s)
+        # thigh 70 degrees forward, shin 30 degrees back, foot flat: hip, knee, ankle follow
+        p.leg(side, hip=1.2 * s + pitch, knee=1.7 * s, ankle=-0.5 * s, spread=0.1 * s)
+        p.arm(side, lower=0.7 - 0.25 * s, forward=1.35 * s, elbow=0.2 * s, shrug=0.15 * s)
     p.trunk(bend=0.2 * s, head_nod=-0.5 * s)
     p.root_turn(pitch=pitch)
     p.plant = ("l_foot", "r_foot")
@@ -182,7 +183,7 @@ def wave(phase, rng):
     raise_ = _smooth_pulse(phase / 0.25) * (1 - _smooth_pulse((phase - 0.8) / 0.2))
     freq = rng.uniform(2.5, 3.5)
     osc = np.sin(2 * np.pi * freq * phase) * raise_
-    p.arm("r", lower=0.7 - 1.55 * raise_, twist=1.4 * raise_, elbow=(1.2 + 0.45 * osc) * raise_
+    p.arm("r", lower=0.7 - 1.55 * raise_, twist=-1.4 * raise_, elbow=(1.2 + 0.45 * osc) * raise_
           + 0.15, shrug=0.15 * raise_)
     p.arm("l", lower=0.7, forward=0.05, elbow=0.15)
     p.trunk(side=-0.08 * raise_, head_turn=-0.2 * raise_)

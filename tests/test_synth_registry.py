@@ -1,0 +1,166 @@
+"""The registry: every collection builds, is deterministic for a seed, differs across seeds,
+and its names and labels are complete and consistent with the named groups."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import data_synth
+from data_synth import COLLECTIONS, list_collections, make_collection
+from data_synth.bar import BAR_MOTIONS
+from data_synth.bodies import DYNA_SHAPES
+from data_synth.face import EXPRESSIONS
+from data_synth.hand import GESTURES
+from data_synth.motions import MOTIONS
+
+NAMES = [n for n, _ in list_collections()]
+#: small templates keep these tests fast; geometry tests use the default sizes
+SMALL = 600
+
+
+def test_public_names():
+    assert data_synth.make_collection is make_collection
+    assert set(NAMES) >= {"scape", "dyna", "jumping", "flag", "bar", "hand", "face"}
+    assert all(isinstance(d, str) and d for _, d in list_collections())
+    assert list(COLLECTIONS) == NAMES
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_deterministic_for_a_seed_and_different_across_seeds(name):
+    a = make_collection(name, seed=3, resolution=SMALL)
+    b = make_collection(name, seed=3, resolution=SMALL)
+    c = make_collection(name, seed=4, resolution=SMALL)
+    np.testing.assert_array_equal(a.vertices, b.vertices)
+    np.testing.assert_array_equal(a.faces, b.faces)
+    assert a.names == b.names
+    for key in a.labels:
+        np.testing.assert_array_equal(a.labels[key], b.labels[key])
+    assert a.vertices.shape == c.vertices.shape
+    np.testing.assert_array_equal(a.faces, c.faces)  # seeds change motion, not connectivity
+    diff = np.abs(a.vertices - c.vertices).max()
+    size = np.ptp(a.vertices[0], axis=0).max()
+    assert diff > 0.01 * size, f"{name}: seeds 3 and 4 differ by only {diff:.2e}"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_default_sizes_and_types(name):
+    col = make_collection(name)
+    N, V, _ = col.vertices.shape
+    assert 500 <= V <= 3000, f"{name}: {V} vertices"
+    assert 20 <= N <= 250, f"{name}: {N} meshes"
+    assert col.vertices.dtype == np.float64 and col.faces.dtype == np.int64
+    assert len(col.names) == N and len(set(col.names)) == N
+    assert col.description
+    for key, value in col.labels.items():
+        assert value.shape == (N,), key
+        assert value.dtype.kind in "iU", f"{name}.{key}: dtype {value.dtype}"
+    assert col.extras["rest"].shape == (V, 3)
+
+
+def test_resolution_controls_vertex_count():
+    for name, target in (("flag", 2000), ("bar", 2000), ("face", 1000)):
+        V = make_collection(name, resolution=target).vertices.shape[1]
+        assert abs(V - target) < 0.1 * target, f"{name}: asked {target}, got {V}"
+
+
+def test_body_scan_resolution_works():
+    col = make_collection("jumping", resolution=7000)
+    assert abs(col.vertices.shape[1] - 7000) < 700
+    assert np.isfinite(col.vertices).all()
+
+
+def test_dyna_labels_form_a_full_grid():
+    col = make_collection("dyna", resolution=SMALL)
+    shapes, motions, frames = col.labels["shape"], col.labels["motion"], col.labels["frame"]
+    assert set(shapes) == set(DYNA_SHAPES) and len(DYNA_SHAPES) >= 4
+    assert set(motions) == set(MOTIONS) and len(MOTIONS) >= 4
+    assert {"walk", "run", "jumping_jacks", "punch", "squat", "wave", "turn"} <= set(MOTIONS)
+    n_frames = frames.max() + 1
+    assert len(col.names) == len(DYNA_SHAPES) * len(MOTIONS) * n_frames
+    keys = set(zip(shapes, motions, frames.tolist()))
+    assert len(keys) == len(col.names)  # every (shape, motion, frame) exactly once
+    for name, s, m, f in zip(col.names, shapes, motions, frames):
+        assert name == f"{s}_{m}_{f:02d}"
+    # shape numbers in extras, one row per shape, consistent with the per-shape dicts
+    M = col.extras["shape_matrix"]
+    assert M.shape == (len(DYNA_SHAPES), len(col.extras["shape_param_names"]))
+    for row, s in zip(M, col.extras["shape_names"]):
+        p = col.extras["shape_params"][s]
+        np.testing.assert_allclose(row, [p[k] for k in col.extras["shape_param_names"]])
+    assert set(col.extras["body_type"]) == {"male", "female"}
+    # body shapes really differ: heights of the rest bodies follow the height parameter
+    heights = np.ptp(col.extras["shape_rest"][:, :, 1], axis=1)
+    order = np.argsort(M[:, 0])
+    assert np.all(np.diff(heights[order]) > 0)
+    # meshes of one shape and one motion change from frame to frame
+    block = col.vertices[(shapes == "male_average") & (motions == "walk")]
+    assert np.abs(np.diff(block, axis=0)).max() > 0.02
+
+
+@pytest.mark.parametrize("name,column,groups", [
+    ("hand", "gesture", set(GESTURES)),
+    ("face", "expression", set(EXPRESSIONS)),
+    ("bar", "motion", set(BAR_MOTIONS)),
+])
+def test_group_labels_are_complete(name, column, groups):
+    col = make_collection(name, resolution=SMALL)
+    assert set(col.labels[column]) == groups
+    counts = {g: int(np.sum(col.labels[column] == g)) for g in groups}
+    assert len(set(counts.values())) == 1, counts  # the same number of frames per group
+    for n, g, f in zip(col.names, col.labels[column], col.labels["frame"]):
+        assert n == f"{g}_{f:02d}"
+
+
+def test_face_intensity_grows_with_displacement():
+    col = make_collection("face", resolution=SMALL)
+    rest = col.extras["rest"]
+    disp = np.abs(col.vertices - rest).max(axis=(1, 2))
+    neutral = col.labels["intensity_pct"] == 0
+    assert disp[neutral].max() < 1e-12
+    peak = col.labels["intensity_pct"] == 100
+    assert disp[peak].min() > 0.003  # at least 3 mm somewhere on the face
+
+
+def test_sequences_are_smooth():
+    """Consecutive frames of the jumping sequence and the flag move much less than the whole
+    motion does (no jumps between frames)."""
+    for name in ("jumping", "flag"):
+        col = make_collection(name, resolution=SMALL)
+        step = np.abs(np.diff(col.vertices, axis=0)).max()
+        span = np.abs(col.vertices - col.vertices[0]).max()
+        assert step < 0.2 * span, f"{name}: a frame jumps by {step:.3f} of {span:.3f}"
+
+
+def test_scape_poses_are_distinct():
+    col = make_collection("scape", resolution=SMALL)
+    X = col.vertices.reshape(len(col.vertices), -1)
+    X = X - X.mean(axis=1, keepdims=True)
+    d = np.sqrt(((X[:, None] - X[None]) ** 2).mean(-1))
+    np.fill_diagonal(d, np.inf)
+    assert d.min() > 0.01  # every pair of poses differs by more than 1 cm RMS
+    assert col.labels["source_motion"][0] == "rest"
+
+
+def test_jumping_is_jumping_jacks():
+    """Arms go from below the shoulders to above the head and the feet leave the ground."""
+    col = make_collection("jumping", resolution=SMALL)
+    V = col.vertices
+    top = V[:, :, 1].max(axis=1)
+    head_top = V[0, :, 1].max()
+    assert (top > head_top + 0.1).any()  # hands above the head in some frames
+    assert np.isclose(top[0], head_top, atol=0.02) or top[0] < head_top + 0.02
+    low = V[:, :, 1].min(axis=1)
+    assert low.max() - low.min() > 0.05  # it jumps
+
+
+@pytest.mark.parametrize("bad", [
+    dict(name="nope"), dict(name="scape", seed=-1), dict(name="scape", resolution=10),
+    dict(name="flag", resolution=10**7), dict(name="bar", resolution=2.5),
+])
+def test_bad_input_raises_value_error_showing_the_value(bad):
+    name = bad.pop("name")
+    with pytest.raises(ValueError) as exc:
+        make_collection(name, **bad)
+    shown = str(list(bad.values())[0]) if bad else name
+    assert shown in str(exc.value)
