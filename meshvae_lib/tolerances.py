@@ -74,8 +74,9 @@ NORMAL_EDGE_WEIGHT = 1.0
 #: polar decomposition: Newton iterations at most, of which the first few are scaled (Higham 1986).
 POLAR_MAX_ITERATIONS = 40
 POLAR_SCALED_ITERATIONS = 8
-#: stop Newton when no entry changes by more than this.
-POLAR_CONVERGENCE = 1e-15
+#: stop Newton when no entry changed by more than this in an unscaled step: convergence is
+#: quadratic, so the result is then orthogonal to ~1e-16.
+POLAR_CONVERGENCE = 1e-9
 #: |det T| below this times |T|_F^3 counts as singular (SVD fallback).
 POLAR_SINGULAR_RTOL = 1e-12
 #: a Newton result farther than this from orthogonal is redone by SVD.

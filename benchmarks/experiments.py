@@ -1,0 +1,170 @@
+"""Run every experiment of the paper (Sec. 5) and write markdown tables and PNG figures.
+
+    .venv/bin/python benchmarks/experiments.py --out build/experiments [--quick] [--only table1,embedding]
+
+``make experiments`` runs it at full size (about 30 minutes on two CPU cores). Writes, in ``--out``:
+
+- ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
+  ``meshvae_lib.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
+  their nearest training meshes), ``interpolation_meshes.png`` (Fig. 6), ``exploration_level1.png``
+  and ``exploration_level2.png`` (Fig. 9);
+- ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
+
+One experiment failing does not stop the others; the exit code is 1 if any failed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import logging
+import os
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from meshvae_lib import experiments as exps  # noqa: E402
+
+SHORT = {
+    "table1": exps.latent_size_table,
+    "table3": exps.feature_table,
+    "table4": exps.robustness_table,
+    "loss": exps.loss_table,
+    "embedding": exps.embedding_table,
+    "generation": exps.generation_table,
+    "interpolation": exps.interpolation_table,
+    "exploration": exps.exploration_table,
+}
+
+
+def _save(fig, path: Path) -> None:
+    fig.savefig(path, dpi=100, bbox_inches="tight")
+
+
+def _renderings(table, out: Path) -> list[str]:
+    """Extra mesh renderings for the tables that have meshes."""
+    try:
+        from meshvae_lib.viewing.render import render_mesh_grid
+    except Exception:  # the viewing package is optional for the numbers
+        logging.warning("meshvae_lib.viewing.render is not available: no mesh renderings")
+        return []
+    written = []
+    d = table.data
+    if table.name == "generation" and "unconditional" in d:
+        res = d["unconditional"]
+        k = min(6, len(res.vertices))
+        meshes = np.concatenate([res.vertices[:k], d["train_vertices"][res.nearest[:k]]])
+        titles = [f"generated {i}" for i in range(k)] + [
+            f"nearest: {res.nearest[i]} (d={res.distance[i]:.2f})" for i in range(k)]
+        _save(render_mesh_grid(meshes, d["faces"], titles=titles, ncols=k,
+                               suptitle="generated (top) and nearest training mesh (bottom)"), out / "generation_meshes.png")
+        written.append("generation_meshes.png")
+        if "conditional" in d:
+            r = d["conditional"]
+            col, val = d["condition"]
+            _save(render_mesh_grid(r.vertices[:k], d["conditional_faces"], ncols=k,
+                                   suptitle=f"conditional mesh VAE, {col} = {val}"), out / "generation_conditional.png")
+            written.append("generation_conditional.png")
+    if table.name == "interpolation":
+        seqs = d["sequences"]
+        names = list(seqs)
+        n = len(next(iter(seqs.values())))
+        meshes = np.concatenate([seqs[m] for m in names])
+        imp = d["implausibility"]
+        titles = [f"{m}: step {i} ({imp.self_intersections[m][i]} x)" for m in names for i in range(n)]
+        _save(render_mesh_grid(meshes, d["faces"], titles=titles, ncols=n, size=1.8,
+                               suptitle="rows: " + " / ".join(names) + "   (x: crossing triangle pairs)"),
+              out / "interpolation_meshes.png")
+        written.append("interpolation_meshes.png")
+    if table.name == "exploration":
+        for key, fname in (("level1", "exploration_level1.png"), ("level2", "exploration_level2.png")):
+            g = d[key]
+            na, nb = g.vertices.shape[:2]
+            titles = [f"z{g.dims[0] + 1}={a:+.1f}, z{g.dims[1] + 1}={b:+.1f}" for a in g.values_a for b in g.values_b]
+            _save(render_mesh_grid(g.vertices.reshape(na * nb, -1, 3), d["faces"], titles=titles, ncols=nb, size=1.8,
+                                   suptitle=f"latent dims {g.dims[0] + 1} (rows) and {g.dims[1] + 1} (columns)"),
+                  out / fname)
+            written.append(fname)
+    return written
+
+
+def _jsonable(table) -> dict:
+    def cell(c):
+        if isinstance(c, (np.floating, float)):
+            return float(c)
+        if isinstance(c, (np.integer, int)):
+            return int(c)
+        return None if c is None else str(c)
+
+    return {"title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
+            "notes": table.notes, "seconds": table.seconds}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", default="build/experiments", help="output folder")
+    p.add_argument("--quick", action="store_true", help="tiny settings (a few minutes in all)")
+    p.add_argument("--only", default="", help="comma-separated subset of: " + ",".join(SHORT))
+    p.add_argument("--threads", type=int, default=2, help="torch threads (default 2)")
+    p.add_argument("-v", "--verbose", action="store_true")
+    args = p.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    import torch
+
+    torch.set_num_threads(args.threads)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    settings = exps.ExperimentSettings.quick() if args.quick else exps.ExperimentSettings()
+    chosen = [s.strip() for s in args.only.split(",") if s.strip()] or list(SHORT)
+    unknown = [c for c in chosen if c not in SHORT]
+    if unknown:
+        p.error(f"unknown experiments {unknown}; choose from {list(SHORT)}")
+    cache: dict = {}
+    results, failed, parts = {}, [], []
+    t_all = time.perf_counter()
+    for key in chosen:
+        fn = SHORT[key]
+        print(f"== {key} ({fn.__name__})", flush=True)
+        try:
+            table = fn(settings=settings, cache=cache)
+        except Exception as exc:  # keep going: report it
+            failed.append(key)
+            tb = traceback.format_exc()
+            print(tb, file=sys.stderr, flush=True)
+            parts.append(f"## {key}\n\nFAILED: `{type(exc).__name__}: {exc}`\n")
+            continue
+        md = table.to_markdown()
+        (out / f"{table.name}.md").write_text(md + "\n")
+        files = []
+        try:
+            _save(table.plot(), out / f"{table.name}.png")
+            files.append(f"{table.name}.png")
+            files += _renderings(table, out)
+        except Exception:
+            print(traceback.format_exc(), file=sys.stderr, flush=True)
+        results[key] = _jsonable(table)
+        parts.append(f"## {key}\n\n{md}\n\n" + "".join(f"![{f}]({f})\n" for f in files))
+        print(md, flush=True)
+        print(f"   ({table.seconds:.0f} s)", flush=True)
+    total = time.perf_counter() - t_all
+    header = (f"# Experiments ({'quick' if args.quick else 'full'} size)\n\n"
+              f"Total time: {total:.0f} s on {os.cpu_count()} CPU core(s), torch threads {args.threads}.\n\n"
+              f"Settings: `{dataclasses.asdict(settings)}`\n\n")
+    (out / "summary.md").write_text(header + "\n".join(parts))
+    (out / "results.json").write_text(json.dumps({"settings": dataclasses.asdict(settings), "seconds": total,
+                                                  "failed": failed, "tables": results}, indent=1))
+    print(f"wrote {out}/summary.md ({total:.0f} s); failed: {failed or 'none'}", flush=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
