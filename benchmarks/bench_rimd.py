@@ -13,7 +13,9 @@ Prints markdown tables:
 3. with ``--shared``: the same on ../shared/data/*.npz when present (horse and cat: Sumner &
    Popovic 2004; pcow: Briceno et al. 2003).
 
-Times are medians of ``--repeats`` runs after one warm-up; the machine is shared, expect noise.
+Times are medians of ``--repeats`` runs after one warm-up, wall clock and (in brackets) the CPU time
+of this process, which is what an idle machine would show: the work is single-threaded. The
+machine is shared, so wall times vary with the load.
 
     OMP_NUM_THREADS=2 .venv/bin/python benchmarks/bench_rimd.py [--shared] [--repeats 5] [--quick]
 """
@@ -50,14 +52,26 @@ CITES = {"horse-gallop": "Sumner & Popovic 2004", "cat-poses": "Sumner & Popovic
          "pcow": "Briceno et al. 2003"}
 
 
-def median_ms(fn, repeats: int) -> float:
+class Timing(float):
+    """Median wall-clock ms, carrying the median CPU ms of this process (``.cpu``)."""
+
+    def __str__(self) -> str:
+        return f"{float(self):.1f} ({self.cpu:.1f})"
+
+
+def median_ms(fn, repeats: int) -> Timing:
+    """Median wall and CPU ms of ``repeats`` calls after one warm-up. CPU time is what the process
+    itself used: close to the wall time of an idle machine, since this work is single-threaded."""
     fn()  # warm-up
-    times = []
+    wall, cpu = [], []
     for _ in range(repeats):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         fn()
-        times.append(time.perf_counter() - t)
-    return 1e3 * statistics.median(times)
+        cpu.append(time.process_time() - c)
+        wall.append(time.perf_counter() - t)
+    out = Timing(1e3 * statistics.median(wall))
+    out.cpu = 1e3 * statistics.median(cpu)
+    return out
 
 
 def peak_mb(fn) -> float:
@@ -95,11 +109,14 @@ def speed_rows(name, V0, F, verts, repeats):
     enc_setup = median_ms(lambda: RIMDEncoder(V0, F), 1)
     enc = RIMDEncoder(V0, F)
     one = median_ms(lambda: enc.transform(verts[-1]), repeats)
-    batch = median_ms(lambda: enc.transform(verts), max(1, repeats // 2)) / len(verts)
+    batch = median_ms(lambda: enc.transform(verts), max(1, repeats // 2))
+    batch_cpu = batch.cpu / len(verts)
+    batch = Timing(batch / len(verts))
+    batch.cpu = batch_cpu
     mem_ext = peak_mb(lambda: enc.transform(verts[-1]))
     feats = enc.transform(verts)
-    rows = [f"| {name} | {len(V0)} | {enc.K} | extraction | {enc_setup:.0f} | {one:.1f} | "
-            f"{batch:.1f} | {mem_ext:.0f} |"]
+    rows = [f"| {name} | {len(V0)} | {enc.K} | extraction | {enc_setup:.0f} | {one} | "
+            f"{batch} | {mem_ext:.0f} |"]
     for method in ("exact", "paper"):
         setup = median_ms(lambda: RIMDReconstructor(V0, F, method=method), 1)
         rec = RIMDReconstructor(V0, F, method=method)
@@ -108,7 +125,7 @@ def speed_rows(name, V0, F, verts, repeats):
         t_noisy = median_ms(lambda: rec.reconstruct(noisy[-1]), repeats)
         mem = peak_mb(lambda: rec.reconstruct(feats[-1]))
         rows.append(f"| {name} | {len(V0)} | {enc.K} | reconstruction, {method} | {setup:.0f} | "
-                    f"{t_one:.1f} | {t_noisy:.1f} (noise 1e-3) | {mem:.0f} |")
+                    f"{t_one} | {t_noisy} (noise 1e-3) | {mem:.0f} |")
     return rows, feats, enc
 
 
@@ -137,8 +154,9 @@ def main(argv=None) -> int:
     repeats = 2 if args.quick else args.repeats
     print(f"threads: OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}, "
           f"cpus visible: {os.cpu_count()}\n")
-    speed = ["| mesh | vertices | K | step | set-up ms (once) | ms per mesh | ms per mesh "
-             "(batch of 8 / noisy) | peak MB |", "|---|---|---|---|---|---|---|---|"]
+    speed = ["| mesh | vertices | K | step | set-up ms (once) | ms per mesh, wall (CPU) | "
+             "ms per mesh: batch of 8 / noisy, wall (CPU) | peak MB |",
+             "|---|---|---|---|---|---|---|---|"]
     acc = ["| mesh | method | rotations | no noise: mean / max | 0.001 rad | 0.01 rad |",
            "|---|---|---|---|---|---|"]
     for name in sizes:
@@ -167,7 +185,8 @@ def main(argv=None) -> int:
     print("\n## Round-trip error / bounding-box diagonal (mean / max over vertices and meshes)\n")
     print("\n".join(acc))
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(f"\nprocess peak RSS: {rss:.0f} MB")
+    print(f"\nprocess peak RSS: {rss:.0f} MB; load average at the end: "
+          f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}")
     return 0
 
 

@@ -33,7 +33,7 @@ import logging
 import numpy as np
 
 from .deformation_gradient import DeformationGradientOperator
-from .rotations import _log_soa, _polar_rs_soa, matmul_soa
+from .rotations import _polar_rs_soa, _quat_from_soa, _relative_log_quat
 from .topology import _check_faces, directed_edges, edge_index, edges
 
 __all__ = [
@@ -204,8 +204,11 @@ class RIMDLayout:
         f : (n_meshes, K) float64
         """
         N = log_dR.shape[0]
-        rot = log_dR[:, self._undirected, :] * self._sign[None, :, None]
-        return np.concatenate([rot.reshape(N, -1), S6.reshape(N, -1)], axis=1)
+        out = np.empty((N, self.K))
+        rot = out[:, self.rotation_slice].reshape(N, self.n_rotation_edges, 3)
+        np.multiply(log_dR[:, self._undirected, :], self._sign[None, :, None], out=rot)
+        out[:, self.scaling_slice] = S6.reshape(N, -1)
+        return out
 
     def unpack(self, features) -> tuple[np.ndarray, np.ndarray]:
         """Split feature rows into undirected rotation vectors and symmetric ``S``.
@@ -307,8 +310,10 @@ class RIMDEncoder:
         offs = (np.arange(N) * n)[:, None]
         ii = (offs + E[:, 0]).reshape(-1)
         jj = (offs + E[:, 1]).reshape(-1)
-        dR = matmul_soa(r[:, ii], r[:, jj], transpose_a=True)  # R_i^T R_j
-        w = _log_soa(dR)  # (3, N E)
+        # log(R_i^T R_j) through unit quaternions: fewer operations than forming R_i^T R_j
+        # (checked against so3_log in the tests)
+        q = _quat_from_soa(r)  # (4, N n)
+        w = _relative_log_quat(q[:, ii], q[:, jj])  # (3, N E)
         log_dR = np.ascontiguousarray(w.T).reshape(N, len(E), 3)
         S6 = np.ascontiguousarray(s[_S_FLAT].T).reshape(N, n, 6)
         return self.layout.pack(log_dR, S6)

@@ -364,3 +364,58 @@ def project_to_so3(M) -> np.ndarray:
     R : (..., 3, 3) float64
     """
     return polar_decomposition(M)[0]
+
+
+def _quat_from_soa(r: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``(4, m)`` (w, x, y, z) of rotations ``(9, m)``, Shepperd's method.
+
+    Each column uses the largest of ``(w, x, y, z)`` as pivot, so the result is accurate to
+    rounding for every angle (including pi); the sign is arbitrary.
+    """
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = r
+    tr = r00 + r11 + r22
+    cand = np.stack([tr, r00, r11, r22])  # 4 |w|^2 - 1 etc. up to affine maps: pick the largest
+    k = np.argmax(cand, axis=0)
+    q = np.empty((4, r.shape[1]))
+    # pivot w
+    s = np.sqrt(np.maximum(1.0 + tr, 0.0)) * 2.0  # 4 w
+    sel = k == 0
+    if sel.any():
+        ss = s[sel]
+        q[0, sel] = 0.25 * ss
+        q[1, sel] = (r21[sel] - r12[sel]) / ss
+        q[2, sel] = (r02[sel] - r20[sel]) / ss
+        q[3, sel] = (r10[sel] - r01[sel]) / ss
+    for axis, (a, b, c) in enumerate(((0, 1, 2), (1, 2, 0), (2, 0, 1)), start=1):
+        sel = k == axis
+        if not sel.any():
+            continue
+        raa, rbb, rcc = r[4 * a][sel], r[4 * b][sel], r[4 * c][sel]
+        ss = np.sqrt(np.maximum(1.0 + raa - rbb - rcc, 0.0)) * 2.0  # 4 q_a
+        q[1 + a, sel] = 0.25 * ss
+        q[0, sel] = (r[3 * c + b][sel] - r[3 * b + c][sel]) / ss
+        q[1 + b, sel] = (r[3 * a + b][sel] + r[3 * b + a][sel]) / ss
+        q[1 + c, sel] = (r[3 * a + c][sel] + r[3 * c + a][sel]) / ss
+    return q
+
+
+def _relative_log_quat(qi: np.ndarray, qj: np.ndarray) -> np.ndarray:
+    """``log(R_i^T R_j)`` as rotation vectors ``(3, m)`` from unit quaternions ``(4, m)``.
+
+    ``conj(q_i) q_j`` is the quaternion of ``R_i^T R_j``; its log is
+    ``2 atan2(|v|, |w|) sign(w) v / |v|``, accurate at every angle (at exactly pi the sign is
+    arbitrary, as for :func:`so3_log`).
+    """
+    aw, ax, ay, az = qi
+    bw, bx, by, bz = qj
+    w = aw * bw + ax * bx + ay * by + az * bz
+    x = aw * bx - ax * bw - (ay * bz - az * by)
+    y = aw * by - ay * bw - (az * bx - ax * bz)
+    z = aw * bz - az * bw - (ax * by - ay * bx)
+    nv = np.sqrt(x * x + y * y + z * z)
+    sign = np.where(w < 0, -1.0, 1.0)
+    theta = 2.0 * np.arctan2(nv, np.abs(w))
+    small = nv < 1e-300
+    # theta / |v| -> 2 / |w| as |v| -> 0 (series: 2 (1 - |v|^2 / (3 w^2)) / |w| is exact enough)
+    factor = np.where(small, 2.0, theta / np.where(small, 1.0, nv)) * sign
+    return np.stack([factor * x, factor * y, factor * z])

@@ -122,3 +122,17 @@ def test_bad_shapes():
         so3_exp(np.zeros((2, 4)))
     with pytest.raises(ValueError, match="NaN"):
         polar_decomposition(np.full((3, 3), np.nan))
+
+
+def test_quaternion_relative_log_matches_matrix_log():
+    from meshvae_lib.rotations import _quat_from_soa, _relative_log_quat, to_soa
+
+    rng = np.random.default_rng(4)
+    w = rng.standard_normal((500, 3))
+    w *= (rng.uniform(0, np.pi, 500) / np.linalg.norm(w, axis=1))[:, None]
+    w[:4] = [[0, 0, 0], [1e-9, 0, 0], [0, np.pi - 1e-6, 0], [0, 0, 1.0]]
+    Ri, Rj = so3_exp(rng.standard_normal((500, 3))), None
+    Rj = Ri @ so3_exp(w)  # so R_i^T R_j = exp(w)
+    got = _relative_log_quat(_quat_from_soa(to_soa(Ri)), _quat_from_soa(to_soa(Rj))).T
+    np.testing.assert_allclose(got, w, atol=1e-14 * 20)
+    np.testing.assert_allclose(got, so3_log(np.swapaxes(Ri, 1, 2) @ Rj), atol=1e-13)
