@@ -139,7 +139,7 @@ def _body_model() -> ImplicitModel:
 class BodyShape:
     """Body-shape parameters.
 
-    height : stature in metres before proportions (1.75 average).
+    height : stature in metres (1.75 average), feet to the top of the head in the rest pose.
     girth : BMI-like bulk factor, 1.0 average (0.85 slim, 1.3 heavy); body mass index is
         roughly ``22 * girth**2``.
     arm_length, leg_length, shoulder_width : proportions, 1.0 average.
@@ -220,7 +220,7 @@ def shape_body(template: BodyTemplate, shape: BodyShape) -> tuple[np.ndarray, np
 
     Returns
     -------
-    V : (n_vertices, 3) float64, shaped rest pose (feet on y = 0).
+    V : (n_vertices, 3) float64, shaped rest pose (feet on y = 0, head top at y = height).
     joints : (n_joints, 3) float64, shaped rest joint positions.
     """
     V0, F, W = template.V, template.F, template.W
@@ -277,8 +277,10 @@ def shape_body(template: BodyTemplate, shape: BodyShape) -> tuple[np.ndarray, np
         b[j] = new[name] - M[j] @ head
     V2 = linear_blend(V1, W, M, b)
     joints = np.array([new[n] for n in NAMES])
-    lift = np.array([0.0, -V2[:, 1].min(), 0.0])
-    return V2 + lift, joints + lift
+    # feet on y = 0, and a uniform scale so the stature is exactly ``shape.height``
+    floor = np.array([0.0, V2[:, 1].min(), 0.0])
+    k = shape.height / np.ptp(V2[:, 1])
+    return (V2 - floor) * k, (joints - floor) * k
 
 
 def pose_body(V_rest: np.ndarray, joints_rest: np.ndarray, template: BodyTemplate,

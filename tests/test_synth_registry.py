@@ -89,10 +89,14 @@ def test_dyna_labels_form_a_full_grid():
         p = col.extras["shape_params"][s]
         np.testing.assert_allclose(row, [p[k] for k in col.extras["shape_param_names"]])
     assert set(col.extras["body_type"]) == {"male", "female"}
-    # body shapes really differ: heights of the rest bodies follow the height parameter
-    heights = np.ptp(col.extras["shape_rest"][:, :, 1], axis=1)
-    order = np.argsort(M[:, 0])
-    assert np.all(np.diff(heights[order]) > 0)
+    # body shapes really differ: the rest bodies' statures are the height parameter, and the
+    # heavier bodies are wider at the waist
+    rest = col.extras["shape_rest"]
+    np.testing.assert_allclose(np.ptp(rest[:, :, 1], axis=1), M[:, 0], rtol=1e-9)
+    waist = (np.abs(rest[:, :, 1] / M[:, :1] - 0.6) < 0.02)  # a band at 60% of the stature
+    widths = [np.ptp(r[w, 0]) / h for r, w, h in zip(rest, waist, M[:, 0])]
+    girth = M[:, 1]
+    assert np.corrcoef(girth, widths)[0, 1] > 0.8
     # meshes of one shape and one motion change from frame to frame
     block = col.vertices[(shapes == "male_average") & (motions == "walk")]
     assert np.abs(np.diff(block, axis=0)).max() > 0.02
