@@ -34,8 +34,9 @@ Positions (``method=``):
   ``h_i``, which free ``m'`` absorbs); a tiny multiple of the paper's Eq. 1 system
   (``EXACT_REGULARIZATION``) decides them, and up to ``EXACT_REFINE_MAX_STEPS`` Gauss-Newton
   steps on ``sum_i |T_i(p') - R_i S_i|^2`` with the true ``m'(p')`` (matrix ``K^T K``, also
-  factorised once) remove what is left. A step is taken only when the residual is above
-  ``EXACT_RESIDUAL_TOL``.
+  factorised once) remove what is left. With ``refine="auto"`` a self-test when the reconstructor
+  is built decides whether the steps are needed for this mesh (``EXACT_SELFTEST_TOL``); a step is
+  skipped when the residual is already below ``EXACT_RESIDUAL_TOL``.
 
 One vertex per connected component is pinned (the feature has no translation); components are
 then placed by the final rigid alignment only, so several components keep their relative
@@ -55,7 +56,7 @@ from . import tolerances as tol
 from .alignment import rigid_align
 from .deformation_gradient import DeformationGradientOperator
 from .rimd import RIMDLayout
-from .rotations import _exp_soa, _polar_rs_soa, matmul_soa
+from .rotations import _exp_soa, _polar_rs_soa, _quat_from_soa, matmul_soa
 from .topology import edge_index
 
 __all__ = ["METHODS", "ROTATION_RECOVERY", "RIMDReconstructor"]
@@ -259,48 +260,46 @@ class RIMDReconstructor:
     # ------------------------------------------------------------------------------------------
     # rotations
 
-    def _rotations_bfs(self, dR: np.ndarray) -> np.ndarray:
-        """Walk the spanning tree: ``R_child = R_parent dR_parent,child``. ``dR`` is (9, E).
+    def _rotations_bfs(self, w: np.ndarray) -> np.ndarray:
+        """Walk the spanning tree: ``R_child = R_parent dR_parent,child``; ``w`` (3, E) holds
+        ``log dR_ij`` of the undirected edges. Returns ``R`` as (9, n).
 
-        One batched product per BFS level (the walk is sequential in depth only).
+        One batched product per BFS level (the walk is sequential in depth only); only the tree
+        edges are exponentiated (``exp(-w) = exp(w)^T`` for edges walked against their order).
         """
         n = self.n_vertices
-        child = np.flatnonzero(self._parent >= 0)
-        d = dR[:, self._parent_edge]  # (9, n): dR of each vertex's tree edge
-        flip = self._parent_flip
-        d[:, flip] = d[_TRANSPOSE][:, flip]
+        sign = np.where(self._parent_flip, -1.0, 1.0)
+        d = _exp_soa(w[:, self._parent_edge] * sign)  # (9, n): dR of each vertex's tree edge
         dm = np.ascontiguousarray(d.T).reshape(n, 3, 3)
         R = np.zeros((n, 3, 3))
         R[self.roots] = np.eye(3)
-        del child
         for lv in self._levels[1:]:
             R[lv] = R[self._parent[lv]] @ dm[lv]
         return np.ascontiguousarray(R.reshape(n, 9).T)
 
-    def _rotations_sync(self, R: np.ndarray, dR: np.ndarray) -> tuple[np.ndarray, int]:
+    def _rotations_sync(self, R: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, int]:
         """Global Gauss-Newton sweeps on all edges; returns (R, sweeps solved).
 
         The residual of edge (i, j) is the axial vector of ``D = R_i dR_ij R_j^T`` (``sin`` of the
-        angle times the axis, equal to ``log D`` to third order, exactly zero when consistent).
+        angle times the axis, equal to ``log D`` to third order, exactly zero when consistent),
+        computed with unit quaternions: ``D ~ q_i dq_ij conj(q_j)``, axial part ``2 w v``.
         """
         E = self.layout.edges
+        dq = _quat_exp(w)  # (4, E)
         sweeps = 0
         for sweeps in range(tol.ROTATION_SYNC_MAX_SWEEPS + 1):
-            X = matmul_soa(R[:, E[:, 0]], dR)  # R_i dR_ij
-            Rj = R[:, E[:, 1]]
-            # axial part of D = X Rj^T: D[a, b] = sum_c X[a, c] Rj[b, c]
-            delta = np.empty((3, len(E)))
-            for k, (a, b) in enumerate(((2, 1), (0, 2), (1, 0))):
-                acc = X[3 * a] * Rj[3 * b] - X[3 * b] * Rj[3 * a]
-                acc += X[3 * a + 1] * Rj[3 * b + 1] - X[3 * b + 1] * Rj[3 * a + 1]
-                acc += X[3 * a + 2] * Rj[3 * b + 2] - X[3 * b + 2] * Rj[3 * a + 2]
-                delta[k] = 0.5 * acc
+            q = _quat_from_soa(R)
+            a = _quat_mul(q[:, E[:, 0]], dq)
+            qj = q[:, E[:, 1]]
+            qj[1:] *= -1.0  # conjugate
+            d = _quat_mul(a, qj)
+            delta = 2.0 * d[0] * d[1:]  # (3, E)
             if sweeps == tol.ROTATION_SYNC_MAX_SWEEPS or (
                     np.max(np.abs(delta)) < tol.ROTATION_SYNC_TOL):
                 break
-            w = self._sync_lu.solve(np.ascontiguousarray(self._Gt @ delta.T))  # (n, 3)
-            R = matmul_soa(_exp_soa(np.ascontiguousarray(w.T)), R)
-            if np.max(np.abs(w)) < tol.ROTATION_SYNC_STEP_TOL:
+            omega = self._sync_lu.solve(np.ascontiguousarray(self._Gt @ delta.T))  # (n, 3)
+            R = matmul_soa(_exp_soa(np.ascontiguousarray(omega.T)), R)
+            if np.max(np.abs(omega)) < tol.ROTATION_SYNC_STEP_TOL:
                 sweeps += 1
                 break
         return R, sweeps
@@ -325,10 +324,9 @@ class RIMDReconstructor:
         return np.ascontiguousarray(r.T).reshape(-1, 3, 3)
 
     def _recover(self, w: np.ndarray) -> np.ndarray:
-        dR = _exp_soa(w)
-        R = self._rotations_bfs(dR)
+        R = self._rotations_bfs(w)
         if self.rotations == "global":
-            R, sweeps = self._rotations_sync(R, dR)
+            R, sweeps = self._rotations_sync(R, w)
             logger.debug("rotation sync: %d sweeps", sweeps)
         return R
 
@@ -457,6 +455,27 @@ class RIMDReconstructor:
         if align:
             out = rigid_align(out, self.V0)
         return out[0] if single else out
+
+
+def _quat_exp(w: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``(4, m)`` of rotation vectors ``(3, m)``: ``(cos(t/2), sin(t/2) w / t)``."""
+    t = np.sqrt(np.einsum("km,km->m", w, w))
+    small = t < tol.SO3_SMALL_ANGLE
+    half = 0.5 * t
+    s = np.where(small, 0.5 - t * t / 48.0, np.sin(half) / np.where(small, 1.0, t))
+    return np.concatenate([np.cos(half)[None], w * s], axis=0)
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions ``(4, m)``."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return np.stack([
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    ])
 
 
 def _block_diag3(P: np.ndarray) -> sp.csr_matrix:
