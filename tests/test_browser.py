@@ -248,5 +248,7 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
         finally:
             (SHOTS / "console.log").write_text("\n".join(console))
             context.close()
-    errors = [m for m in console if m.startswith("pageerror") or ("error" in m.split(":")[0] and "three" in m.lower())]
-    assert not errors, f"browser errors: {errors[:5]}"
+    # No error from the page or any widget (pythreejs logs "Error setting state" for lights with
+    # shadows and "Cannot convert undefined..." for computeVertexNormals; the viewer avoids both).
+    errors = [m for m in console if m.startswith(("pageerror", "error")) and "Failed to load resource" not in m]
+    assert not errors, f"browser console errors (see {SHOTS / 'console.log'}): {errors[:5]}"

@@ -227,12 +227,15 @@ class MeshViewer:
         aspect = self.width / self.height
         position, target = fit_camera(pts, fov=40.0, aspect=aspect)
         scale = float(np.linalg.norm(position - target))
-        light = three.DirectionalLight(color="white", intensity=0.65,
-                                       position=tuple(float(x) for x in np.array([-0.4, 0.6, 0.3]) * scale))
+        # A hemisphere light riding on the camera: it turns with the orbit controls. (Directional,
+        # point and spot lights make pythreejs 2.4.2 log "Error setting state: t.on is not a
+        # function" in JupyterLab 4 -- their shadow models -- so they are not used.)
+        light = three.HemisphereLight(color="#ffffff", groundColor="#404040", intensity=0.8,
+                                      position=tuple(float(x) for x in np.array([-0.4, 0.8, 0.0]) * scale))
         self.camera = three.PerspectiveCamera(position=tuple(float(x) for x in position), fov=40.0, aspect=aspect,
                                               near=scale * 1e-3, far=scale * 100.0, children=[light])
         self._home = (tuple(float(x) for x in position), tuple(float(x) for x in target))
-        self.scene = three.Scene(children=[*self._meshes, self.camera, three.AmbientLight(color="white", intensity=0.45)],
+        self.scene = three.Scene(children=[*self._meshes, self.camera, three.AmbientLight(color="white", intensity=0.35)],
                                  background=background)
         self.controls = three.OrbitControls(controlling=self.camera, target=tuple(float(x) for x in target))
         self.renderer = three.Renderer(camera=self.camera, scene=self.scene, controls=[self.controls],
