@@ -140,3 +140,15 @@ def test_snapshot_png_in_display_data_and_current_figure(sphere):
     assert [ax.get_title() for ax in fig.axes] == ["a", "b"]
     spans = [ax.collections[0].get_datalim(ax.transData).width for ax in fig.axes]
     assert spans[1] > 2.0 * spans[0]  # the figure shows the updated, stretched mesh
+
+
+def test_colour_list_with_default_entries(sphere):
+    V, F = sphere
+    red = np.tile([1.0, 0.0, 0.0], (len(V), 1))
+    v = MeshViewer([V, V], F, colors=[None, red], mode="threejs")
+    from matplotlib.colors import to_rgb
+
+    from meshvae_lib.viewing.colors import DEFAULT_MESH_COLOR
+
+    np.testing.assert_allclose(v._color_attrs[0].array[0], to_rgb(DEFAULT_MESH_COLOR), atol=1e-6)
+    np.testing.assert_allclose(v._color_attrs[1].array, red, atol=1e-6)

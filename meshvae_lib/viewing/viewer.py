@@ -71,7 +71,8 @@ class MeshViewer:
     F : (n_faces, 3) int
         Shared triangles.
     colors : colour, (n_vertices, 3), (n_meshes, n_vertices, 3) float, or list per mesh; optional
-        Explicit per-vertex RGB in [0, 1] (overrides ``values`` and ``labels``).
+        Explicit per-vertex RGB in [0, 1] (overrides ``values`` and ``labels``); in a list, None
+        means the default colour (e.g. ``[None, err_colors]`` for truth and reconstruction).
     values : (n_vertices,) or (n_meshes, n_vertices) float, optional
         A scalar per vertex (e.g. an error), coloured with ``cmap`` over one shared range, with a
         colour bar under the view.
@@ -152,7 +153,7 @@ class MeshViewer:
         k, n = self.n_meshes, self.n_vertices
         if colors is not None:
             if isinstance(colors, (list, tuple)) and len(colors) == k and not isinstance(colors[0], (int, float)):
-                return [color_buffer(c, n) for c in colors]
+                return [color_buffer(DEFAULT_MESH_COLOR if c is None else c, n) for c in colors]
             C = colors if isinstance(colors, str) else np.asarray(colors, dtype=np.float64)
             if not isinstance(C, str) and C.ndim == 3:
                 if C.shape[0] != k:
