@@ -128,7 +128,8 @@ def main(argv=None):
     import torch
 
     print(f"LatentExplorer slider move, end to end (OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']}, "
-          f"torch threads {torch.get_num_threads()}, {os.cpu_count()} CPUs visible); target < {TARGET_MS:.0f} ms")
+          f"torch threads {torch.get_num_threads()}, {os.cpu_count()} CPUs visible, "
+          f"load average {os.getloadavg()[0]:.1f}); target < {TARGET_MS:.0f} ms")
     head = f"{'vertices':>8} {'faces':>6}  {'decoder':<18} {'median ms':>9} {'p90 ms':>7}  {'decode':>7} {'normals':>7} {'buffers':>7}  <100ms"
     print(head)
     print("-" * len(head))
