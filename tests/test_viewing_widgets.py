@@ -226,3 +226,21 @@ def test_slow_decoder_switches_sliders_to_update_on_release(sphere, monkeypatch)
     for v in (0.5, 1.0, 1.5):
         fixed.sliders[0].value = v
     assert fixed.live  # an explicit choice is kept
+
+
+def test_frame_player_colours_each_frame_on_one_range(sphere):
+    V, F = sphere
+    frames = np.stack([V * s for s in (1.0, 1.5, 2.0)])
+    err = np.stack([np.full(len(V), e) for e in (0.0, 1.0, 4.0)])  # (3 frames, n)
+    p = FramePlayer(frames, F, frame_values=err, cmap="viridis", value_label="err", mode="threejs")
+    assert (p.viewer.mapping.vmin, p.viewer.mapping.vmax) == (0.0, 4.0)
+    c0 = p.viewer._color_attrs[0].array[0].copy()
+    p.frame = 2
+    c2 = p.viewer._color_attrs[0].array[0]
+    assert p.viewer.mapping.vmax == 4.0  # the range stays fixed across frames
+    import matplotlib
+
+    np.testing.assert_allclose(c0, matplotlib.colormaps["viridis"](0.0)[:3], atol=1e-6)
+    np.testing.assert_allclose(c2, matplotlib.colormaps["viridis"](1.0)[:3], atol=1e-6)
+    with pytest.raises(ValueError, match=r"frame_values must have shape \(3, 162\)"):
+        FramePlayer(frames, F, frame_values=err[:2], mode="threejs")

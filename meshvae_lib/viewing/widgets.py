@@ -66,6 +66,10 @@ class FramePlayer(_Displayable):
         One per sequence.
     loop : bool
         Whether playback repeats.
+    frame_values : (n_frames, n_vertices) or (n_frames, n_sequences, n_vertices) float, optional
+        A scalar per vertex and frame (e.g. each method's error over time), coloured on one range
+        for the whole sequence (``vmin``/``vmax`` default to its minimum and maximum), with a
+        colour bar; ``cmap`` and ``value_label`` as for :class:`MeshViewer`.
     **viewer_kw
         Passed to :class:`MeshViewer` (``colors``, ``values``, ``width``, ``mode``, ...).
 
@@ -78,7 +82,8 @@ class FramePlayer(_Displayable):
     n_frames : int
     """
 
-    def __init__(self, frames, F, fps: float = 10.0, titles=None, loop: bool = True, **viewer_kw):
+    def __init__(self, frames, F, fps: float = 10.0, titles=None, loop: bool = True, frame_values=None,
+                 **viewer_kw):
         import ipywidgets as W
 
         seqs = frames if isinstance(frames, (list, tuple)) else [frames]
@@ -94,6 +99,24 @@ class FramePlayer(_Displayable):
             raise ValueError(f"fps must be positive, got {fps}")
         self._frames = np.stack(stacks, axis=1)  # (n_frames, n_sequences, n_vertices, 3)
         self.n_frames = self._frames.shape[0]
+        self._frame_values = None
+        if frame_values is not None:
+            T, k, n = self._frames.shape[:3]
+            fv = np.asarray(frame_values, dtype=np.float64)
+            if fv.shape == (T, n):
+                fv = np.broadcast_to(fv[:, None, :], (T, k, n))
+            if fv.shape != (T, k, n):
+                raise ValueError(f"frame_values must have shape ({T}, {n}) or ({T}, {k}, {n}), got {fv.shape}")
+            finite = fv[np.isfinite(fv)]
+            self._value_kw = dict(
+                cmap=viewer_kw.pop("cmap", "viridis"),
+                vmin=viewer_kw.pop("vmin", float(finite.min()) if finite.size else 0.0),
+                vmax=viewer_kw.pop("vmax", float(finite.max()) if finite.size else 1.0),
+                value_label=viewer_kw.pop("value_label", ""),
+            )
+            self._frame_values = fv
+            viewer_kw["values"] = fv[0]
+            viewer_kw.update(self._value_kw)
         self.viewer = MeshViewer(list(self._frames[0]), F, titles=titles, **viewer_kw)
         self.play = W.Play(value=0, min=0, max=self.n_frames - 1, step=1, interval=int(round(1000 / fps)),
                            repeat=loop, description="play")
@@ -106,7 +129,10 @@ class FramePlayer(_Displayable):
         self.widget.add_class("meshvae-frame-player")
 
     def _on_frame(self, change):
-        self.viewer.update(list(self._frames[int(change["new"])]))
+        k = int(change["new"])
+        self.viewer.update(list(self._frames[k]))
+        if self._frame_values is not None:
+            self.viewer.set_colors(values=self._frame_values[k], **self._value_kw)
 
     @property
     def frame(self) -> int:
