@@ -129,3 +129,6 @@ EXACT_SELFTEST_TOL = 1e-8
 #: floor added to the encoder's deviation in the experiments' networks, so that log(sigma^2) in
 #: the KL term stays finite when alpha = 1e6 drives sigma towards 0 (float32 underflow otherwise).
 SIGMA_FLOOR = 1e-6
+#: floor of the deviation head's input: sigma = SIGMA_MAX * sigmoid(max(s, SIGMA_LOGIT_MIN)) keeps
+#: sigma >= 1.9e-13, so log(sigma^2) stays finite when alpha = 1e6 drives sigma towards 0.
+SIGMA_LOGIT_MIN = -30.0

@@ -247,6 +247,10 @@ def train_vae(
             w = len(idx) / n
             for key in sums:
                 sums[key] += w * float(parts[key].detach())
+        if not np.isfinite(sums["total"]):
+            bar.close()
+            raise ValueError(f"training diverged at epoch {epoch + 1} (loss {sums['total']}); try a smaller"
+                             f" learning rate (now {config.lr:g}) or alpha (now {config.alpha:g})")
         record = {"epoch": epoch + 1, **sums}
         last = epoch + 1 == config.epochs
         if xv is not None and ((epoch + 1) % config.eval_every == 0 or last):

@@ -29,7 +29,7 @@ from typing import Sequence
 import torch
 from torch import nn
 
-from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
+from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_LOGIT_MIN, SIGMA_MAX
 
 __all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear"]
 
@@ -195,12 +195,15 @@ class MeshVAE(nn.Module):
         """Probabilistic encoder q(z | x, c).
 
         x : (B, K) float32 normalised features; c : (B, C) float32 or None.
-        Returns mu : (B, D) and sigma : (B, D) float32, 0 < sigma < sigma_max.
+        Returns mu : (B, D) and sigma : (B, D) float32, 0 < sigma < sigma_max (the sigmoid's input
+        is floored at SIGMA_LOGIT_MIN = -30, so sigma >= 1.9e-13 and log sigma^2 stays finite).
         """
         h = self.encoder_body(self._with_condition(x, c, self.n_features, "features"))
         out = self.encoder_head(h)
         mu, s = out[:, : self.latent_dim], out[:, self.latent_dim :]
-        return mu, self.sigma_max * torch.sigmoid(s)
+        # With K ~ 1e4-1e5 inputs an Adam step can move s by ~10, and alpha = 1e6 pushes sigma to
+        # 0: without a floor sigmoid underflows, log(sigma^2) = -inf and training turns to NaN.
+        return mu, self.sigma_max * torch.sigmoid(s.clamp(min=SIGMA_LOGIT_MIN))
 
     def reparameterize(
         self, mu: torch.Tensor, sigma: torch.Tensor, generator: torch.Generator | None = None
