@@ -27,11 +27,11 @@ SHORT_EDGE_FRACTION = 0.3
 
 # --- quality limits the generators guarantee (and the tests check) -----------------------------
 #: every triangle keeps at least this fraction of its rest-pose area in every frame.
-MIN_AREA_RATIO = 0.05
+MIN_AREA_RATIO = 0.1
 #: and at most this multiple of it.
 MAX_AREA_RATIO = 8.0
 #: every edge keeps its length within [MIN_EDGE_RATIO, MAX_EDGE_RATIO] x its rest length.
-MIN_EDGE_RATIO = 0.08
+MIN_EDGE_RATIO = 0.2
 MAX_EDGE_RATIO = 5.0
 #: the normals of two triangles sharing an edge differ by less than this (degrees) in every
 #: frame: a larger angle means a triangle folded over (inverted) or a pinched crease.

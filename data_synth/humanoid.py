@@ -103,6 +103,9 @@ def _body_model() -> ImplicitModel:
         Ellipsoid((0.0, 0.935, -0.01), (0.165, 0.13, 0.115), j("pelvis")),
         Ellipsoid((0.0, 1.10, 0.0), (0.14, 0.13, 0.10), j("spine")),
         Ellipsoid((0.0, 1.30, -0.01), (0.165, 0.16, 0.11), j("chest")),
+        # fillers between the torso ellipsoids keep the flanks smooth (no rings at the waist)
+        Ellipsoid((0.0, 1.02, -0.005), (0.152, 0.10, 0.105), j("pelvis")),
+        Ellipsoid((0.0, 1.19, -0.005), (0.148, 0.12, 0.102), j("spine")),
         Capsule((0.0, 1.44, -0.025), (0.0, 1.60, -0.01), 0.052, 0.048, j("neck")),
         Ellipsoid((0.0, 1.665, 0.005), (0.078, 0.105, 0.095), j("head")),
         Ellipsoid((0.0, 1.605, 0.035), (0.058, 0.06, 0.068), j("head")),

@@ -244,7 +244,9 @@ def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
     # random offsets: spine and neck, and limbs within comfortable ranges
     u = lambda a: rng.uniform(-a, a, size=n)  # noqa: E731
     for side in ("l", "r"):
-        pose.arm(side, lower=u(0.5), forward=u(0.5), twist=u(0.4), elbow=np.abs(u(0.6)))
+        # arms mostly move away from the torso (pressing them into it would interpenetrate)
+        pose.arm(side, lower=u(0.12) - np.abs(u(0.5)), forward=u(0.5), twist=u(0.4),
+                 elbow=np.abs(u(0.6)))
         pose.leg(side, hip=u(0.25), knee=np.abs(u(0.3)), spread=np.abs(u(0.1)))
     pose.trunk(bend=u(0.3), twist=u(0.4), side=u(0.2), head_nod=u(0.3), head_turn=u(0.5))
     return pose, chosen
