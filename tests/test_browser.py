@@ -156,9 +156,14 @@ def _poll(fn, timeout: float, interval: float = 0.3):
 
 def _dismiss_kernel_dialog(page) -> None:
     """Accept a 'Select Kernel' dialog if the start-up race shows one."""
+    from playwright.sync_api import Error as PlaywrightError
+
     dialog = page.locator(".jp-Dialog")
-    if dialog.count() and "Kernel" in (dialog.first.inner_text(timeout=2_000) or ""):
-        page.locator(".jp-Dialog .jp-mod-accept").first.click(timeout=5_000)
+    try:
+        if dialog.count() and "Kernel" in (dialog.first.inner_text(timeout=2_000) or ""):
+            page.locator(".jp-Dialog .jp-mod-accept").first.click(timeout=5_000)
+    except PlaywrightError:  # the dialog closed between the check and the click: nothing to do
+        pass
 
 
 def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
