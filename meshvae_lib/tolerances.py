@@ -85,8 +85,8 @@ POLAR_ORTHOGONALITY_TOL = 1e-10
 SO3_SMALL_ANGLE = 1e-4
 #: log: when cos(theta) is below this, the axis comes from the symmetric part of R (near pi).
 SO3_NEAR_PI_COS = -0.7
-#: rotation recovery: stop the global (Lie-algebra least-squares) sweeps once every correction
-#: is below this many radians.
+#: rotation recovery: no global (Lie-algebra least-squares) sweep when every edge residual
+#: |axial(R_i dR_ij R_j^T)| is below this (exact features).
 ROTATION_SYNC_TOL = 1e-13
 #: rotation recovery: at most this many global sweeps.
 ROTATION_SYNC_MAX_SWEEPS = 3
