@@ -97,3 +97,9 @@ def test_progress_bar_is_shown_when_asked(capsys):
     X = _data(n=8, k=10)
     train_vae(X, config=TrainConfig(epochs=2, latent_dim=2, progress=True))
     assert "training mesh VAE" in capsys.readouterr().err
+
+
+def test_divergence_stops_with_a_clear_error():
+    X = _data(n=8, k=10)
+    with pytest.raises(ValueError, match=r"diverged at epoch \d+ \(loss nan\); try a smaller learning rate"):
+        train_vae(X, config=TrainConfig(epochs=3, latent_dim=2, lr=1e30, alpha=1e30, progress=False))

@@ -115,3 +115,18 @@ def test_in_place_linear_gives_the_same_gradients_as_nn_linear():
         torch.testing.assert_close(ours.weight.grad, ref.weight.grad)
         torch.testing.assert_close(ours.bias.grad, ref.bias.grad)
         torch.testing.assert_close(x.grad, x2.grad)
+
+
+def test_kl_stays_finite_when_the_deviation_head_saturates():
+    # alpha = 1e6 drives sigma to 0 and one Adam step at large K can move the logit by ~10:
+    # the floor keeps log(sigma^2) finite (without it: sigmoid underflow, -inf, NaN gradients)
+    net = MeshVAE(20, latent_dim=3)
+    with torch.no_grad():
+        net.encoder_head.bias[3:] = -1000.0
+    x = torch.rand(4, 20) * 1.8 - 0.9
+    x_hat, mu, sigma = net(x, generator=torch.Generator().manual_seed(0))
+    assert torch.all(sigma > 0)
+    parts = vae_loss(x_hat, x, mu, sigma)
+    assert torch.isfinite(parts["total"])
+    parts["total"].backward()
+    assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
