@@ -77,9 +77,38 @@ def chromium_path() -> str:
     return CHROMIUM
 
 
+class LabServer:
+    """A running ``jupyter lab`` process: ``base`` URL, ``aux`` folder, ``wait_ready()``."""
+
+    def __init__(self, proc: subprocess.Popen, base: str, aux: Path):
+        self.proc, self.base, self.aux = proc, base, aux
+        self.started = time.monotonic()
+        self.ready_after: float | None = None
+
+    def wait_ready(self, timeout: float = 45.0) -> None:
+        if self.ready_after is None:
+            _wait_http(f"{self.base}/api/status", self.proc, timeout=timeout)
+            self.ready_after = time.monotonic() - self.started
+
+    def shutdown_kernels(self) -> None:
+        """Ask the server to stop its kernels (fast, graceful); errors are ignored."""
+        try:
+            with urllib.request.urlopen(f"{self.base}/api/kernels", timeout=5) as r:
+                kernels = json.load(r)
+            for k in kernels:
+                req = urllib.request.Request(f"{self.base}/api/kernels/{k['id']}", method="DELETE")
+                urllib.request.urlopen(req, timeout=10).close()
+        except (OSError, ValueError):
+            pass
+
+
 @pytest.fixture(scope="module")
 def lab_server(tmp_path_factory):
-    """A JupyterLab server on a free port serving a copy of the check notebook; always killed."""
+    """A JupyterLab server on a free port serving a copy of the check notebook; always killed.
+
+    The fixture does not wait for the server: the test launches Chromium meanwhile and then calls
+    ``wait_ready()``.
+    """
     root = tmp_path_factory.mktemp("lab")
     aux = tmp_path_factory.mktemp("lab-aux")  # settings, runtime, logs: outside the served tree
     shutil.copy(NOTEBOOK, root / NOTEBOOK.name)
@@ -93,17 +122,19 @@ def lab_server(tmp_path_factory):
     log = open(aux / "server.log", "wb")
     cmd = [
         sys.executable, "-m", "jupyter", "lab", "--no-browser", "--allow-root",
-        f"--ServerApp.ip=127.0.0.1", f"--ServerApp.port={port}", "--ServerApp.port_retries=0",
+        "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={port}", "--ServerApp.port_retries=0",
         "--IdentityProvider.token=", "--ServerApp.password=", "--ServerApp.disable_check_xsrf=True",
         f"--ServerApp.root_dir={root}", f"--LabApp.workspaces_dir={aux / 'workspaces'}",
         f"--LabApp.user_settings_dir={settings}", "--LabApp.expose_app_in_browser=True",
     ]
     proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    server = LabServer(proc, f"http://127.0.0.1:{port}", aux)
     try:
-        _wait_http(f"http://127.0.0.1:{port}/api/status", proc, timeout=45)
-        yield f"http://127.0.0.1:{port}", aux
+        yield server
     finally:
         if proc.poll() is None:
+            if server.ready_after is not None:
+                server.shutdown_kernels()
             try:
                 os.killpg(proc.pid, signal.SIGTERM)
                 proc.wait(timeout=10)
@@ -170,9 +201,14 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
     from playwright.sync_api import Error as PlaywrightError
     from playwright.sync_api import sync_playwright
 
-    base, aux = lab_server
+    aux = lab_server.aux
     SHOTS.mkdir(parents=True, exist_ok=True)
     console: list[str] = []
+    t_start = time.monotonic()
+    phases: list[tuple[str, float]] = []
+
+    def phase(name: str) -> None:
+        phases.append((name, time.monotonic() - t_start))
     with sync_playwright() as pw:
         try:
             context = pw.chromium.launch_persistent_context(
@@ -182,6 +218,10 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
         except PlaywrightError as err:
             pytest.skip(f"playwright could not launch {chromium_path}: {str(err).splitlines()[0]}")
         try:
+            phase("chromium launched")
+            lab_server.wait_ready()
+            base = lab_server.base
+            phase(f"server ready ({lab_server.ready_after:.1f} s after its start)")
             page = context.pages[0] if context.pages else context.new_page()
             page.on("console", lambda m: console.append(f"{m.type}: {m.text}"))
             page.on("pageerror", lambda e: console.append(f"pageerror: {e}"))
@@ -195,8 +235,10 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
                 " const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;"
                 " return !!k && k.connectionStatus === 'connected' && k.status === 'idle'; }"))[1], timeout=30)
             assert ready, "the notebook's kernel did not become idle within 30 s"
+            phase("notebook open, kernel idle")
             page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
             page.wait_for_selector("text=viewer-check-ready threejs threejs", timeout=40_000)
+            phase("all cells ran")
 
             viewer_canvas = page.locator(".meshvae-viewer canvas").first
             explorer_canvas = page.locator(".meshvae-latent-explorer .meshvae-viewer canvas").first
@@ -206,13 +248,21 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
                 loc.scroll_into_view_if_needed(timeout=5_000)
 
             # 1. The WebGL canvases drew something: meshes, not just the background.
-            drawn = _poll(lambda: _drawn_fraction(_shot(viewer_canvas, "01-viewer.png")) > MIN_DRAWN_FRACTION, 20)
-            frac = _drawn_fraction(_shot(viewer_canvas, "01-viewer.png"))
-            assert drawn, f"the viewer's canvas is blank: only {frac:.4f} of pixels differ from the background"
+            last = {}
+
+            def drawn(loc, name):
+                last[name] = _shot(loc, name)
+                return _drawn_fraction(last[name]) > MIN_DRAWN_FRACTION
+
+            ok = _poll(lambda: drawn(viewer_canvas, "01-viewer.png"), 20)
+            assert ok, (f"the viewer's canvas is blank: only {_drawn_fraction(last['01-viewer.png']):.4f} "
+                        f"of pixels differ from the background")
             explorer_canvas.scroll_into_view_if_needed(timeout=5_000)
-            assert _poll(lambda: _drawn_fraction(_shot(explorer_canvas, "02-explorer.png")) > MIN_DRAWN_FRACTION, 20), \
-                "the latent explorer's canvas is blank"
-            before = _shot(explorer_canvas, "02-explorer.png")
+            ok = _poll(lambda: drawn(explorer_canvas, "02-explorer.png"), 20)
+            assert ok, (f"the latent explorer's canvas is blank: only "
+                        f"{_drawn_fraction(last['02-explorer.png']):.4f} of pixels differ from the background")
+            before = last["02-explorer.png"]
+            phase("canvases drawn")
 
             # 2. Drag the z[2] slider: the readout and the canvas change.
             readout = page.locator(".meshvae-z2 .widget-readout").first
@@ -228,12 +278,16 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
             page.mouse.up()
             assert _poll(lambda: readout.inner_text() != old_text, 10), f"the z[2] readout stayed at {old_text}"
             explorer_canvas.scroll_into_view_if_needed(timeout=5_000)
-            changed = _poll(lambda: _changed_fraction(before, _shot(explorer_canvas, "03-explorer-after-slider.png"))
-                            > MIN_CHANGED_FRACTION, 15)
-            after = _shot(explorer_canvas, "03-explorer-after-slider.png")
+            def changed_from(ref, name):
+                last[name] = _shot(explorer_canvas, name)
+                return _changed_fraction(ref, last[name]) > MIN_CHANGED_FRACTION
+
+            changed = _poll(lambda: changed_from(before, "03-explorer-after-slider.png"), 15)
+            after = last["03-explorer-after-slider.png"]
             assert changed, (f"the explorer's canvas did not change after the slider moved "
                              f"({_changed_fraction(before, after):.4f} of pixels changed); readout {readout.inner_text()}")
 
+            phase("slider moved, canvas changed")
             # 3. Click the 2D pad (upper right quarter): z[0] and z[1] follow, the mesh changes again.
             r0 = page.locator(".meshvae-z0 .widget-readout").first
             r1 = page.locator(".meshvae-z1 .widget-readout").first
@@ -247,11 +301,13 @@ def test_viewer_and_latent_explorer_in_jupyterlab(chromium_path, lab_server):
                 f"upper-right click should give positive z[0], z[1]; got {r0.inner_text()}, {r1.inner_text()}"
             _shot(pad_canvas, "04-pad.png")
             explorer_canvas.scroll_into_view_if_needed(timeout=5_000)
-            assert _poll(lambda: _changed_fraction(after, _shot(explorer_canvas, "05-explorer-after-pad.png"))
-                         > MIN_CHANGED_FRACTION, 15), "the explorer's canvas did not change after the pad click"
+            assert _poll(lambda: changed_from(after, "05-explorer-after-pad.png"), 15), \
+                "the explorer's canvas did not change after the pad click"
+            phase("pad clicked, canvas changed")
             page.screenshot(path=str(SHOTS / "06-page.png"))
         finally:
             (SHOTS / "console.log").write_text("\n".join(console))
+            (SHOTS / "timings.txt").write_text("".join(f"{t:6.1f} s  {n}\n" for n, t in phases))
             context.close()
     # No error from the page or any widget (pythreejs logs "Error setting state" for lights with
     # shadows and "Cannot convert undefined..." for computeVertexNormals; the viewer avoids both).
