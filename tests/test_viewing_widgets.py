@@ -244,3 +244,41 @@ def test_frame_player_colours_each_frame_on_one_range(sphere):
     np.testing.assert_allclose(c2, matplotlib.colormaps["viridis"](1.0)[:3], atol=1e-6)
     with pytest.raises(ValueError, match=r"frame_values must have shape \(3, 162\)"):
         FramePlayer(frames, F, frame_values=err[:2], mode="threejs")
+
+
+def test_from_encodings_picks_the_dimensions_the_data_uses(sphere):
+    V, F = sphere
+    rng = np.random.default_rng(3)
+    Z = rng.normal(scale=0.01, size=(40, 16)) + 0.5  # mostly collapsed dimensions around 0.5
+    Z[:, 7] = rng.normal(loc=1.0, scale=2.0, size=40)
+    Z[:, 2] = rng.normal(loc=-1.0, scale=0.5, size=40)
+    dec = LinearDecoder(V, 16)
+    e = LatentExplorer.from_encodings(dec, Z, F, n_dims=3, seed=1, mode="threejs")
+    assert e.dims[:2] == [7, 2]
+    np.testing.assert_allclose(e.z0, Z.mean(axis=0))
+    lo, hi = e.ranges[7]
+    assert lo == pytest.approx(Z[:, 7].mean() - 3 * Z[:, 7].std()) and hi == pytest.approx(Z[:, 7].mean() + 3 * Z[:, 7].std())
+    assert (e.sliders[7].min, e.sliders[7].max) == pytest.approx((lo, hi))
+    assert e.sliders[2].max - e.sliders[2].min < e.sliders[7].max - e.sliders[7].min
+    # random draws follow the data: centred on its mean, scaled by its spread, inside the ranges
+    draws = np.array([e.randomize()[[7, 2]] for _ in range(200)])
+    assert abs(draws[:, 0].mean() - Z[:, 7].mean()) < 0.5
+    assert draws[:, 0].std() > 3 * draws[:, 1].std()
+    assert np.all((draws[:, 0] >= lo - 1e-12) & (draws[:, 0] <= hi + 1e-12))
+    with pytest.raises(ValueError, match=r"n_meshes >= 2"):
+        LatentExplorer.from_encodings(dec, Z[:1], F, mode="threejs")
+    with pytest.raises(ValueError, match=r"n_dims must be in 1..16, got 0"):
+        LatentExplorer.from_encodings(dec, Z, F, n_dims=0, mode="threejs")
+
+
+def test_per_slider_ranges_are_validated(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 3)
+    e = LatentExplorer(dec, 3, F, dims=[0, 1], value_range=[[-1, 1], [0, 5]], mode="threejs")
+    assert (e.sliders[1].min, e.sliders[1].max) == (0.0, 5.0)
+    e.pad.pick(1.0, 1.0)
+    np.testing.assert_allclose(e.z[:2], [1.0, 5.0])
+    with pytest.raises(ValueError, match="low < high"):
+        LatentExplorer(dec, 3, F, dims=[0, 1], value_range=[[-1, 1], [2, 2]], mode="threejs")
+    with pytest.raises(ValueError, match="random_scale"):
+        LatentExplorer(dec, 3, F, dims=[0, 1], random_scale=[1.0, 2.0, 3.0], mode="threejs")

@@ -269,8 +269,9 @@ class LatentExplorer(_Displayable):
         Latent dimensions that get a slider (default the first ``min(latent_dim, 6)``).
     z0 : (latent_dim,) float, optional
         Starting point and what "reset" returns to (default zeros, the prior mean).
-    value_range : (float, float)
-        Slider range (default (-3, 3): three prior standard deviations).
+    value_range : (float, float) or (len(dims), 2) float
+        Slider range, shared or one row per slider (default (-3, 3): three prior standard
+        deviations).
     step : float
         Slider step.
     pad_dims : (int, int) or None
@@ -278,8 +279,10 @@ class LatentExplorer(_Displayable):
     pad_event : {"click", "mousemove"}
     seed : int
         Seed of the "random" button's generator (successive clicks give a reproducible sequence).
-    random_scale : float
-        Standard deviation of the random draws (clipped to ``value_range``).
+    random_scale : float or (len(dims),) float
+        Standard deviation of the random draws (clipped to the slider ranges).
+    random_mean : (latent_dim,) float, optional
+        Centre of the random draws (default zeros, the prior mean).
     reference : (n_vertices, 3) float, optional
         A fixed mesh shown to the left of the decoded one(s), for comparison.
     color_by : {None, "displacement"}
@@ -306,7 +309,7 @@ class LatentExplorer(_Displayable):
 
     def __init__(self, decode, latent_dim: int, F, dims=None, z0=None, value_range=(-3.0, 3.0),
                  step: float = 0.05, pad_dims="auto", pad_event: str = "click", seed: int = 0,
-                 random_scale: float = 1.0, reference=None, color_by=None, continuous_update="auto",
+                 random_scale=1.0, random_mean=None, reference=None, color_by=None, continuous_update="auto",
                  titles=None, **viewer_kw):
         import ipywidgets as W
 
@@ -319,10 +322,13 @@ class LatentExplorer(_Displayable):
         if not dims or len(set(dims)) != len(dims) or min(dims) < 0 or max(dims) >= latent_dim:
             raise ValueError(f"dims must be distinct indices in 0..{latent_dim - 1}, got {dims}")
         self.dims = dims
-        lo, hi = (float(v) for v in value_range)
-        if not hi > lo:
-            raise ValueError(f"value_range must be (low, high) with low < high, got {value_range}")
-        self.value_range = (lo, hi)
+        vr = np.asarray(value_range, dtype=np.float64)
+        if vr.shape == (2,):
+            vr = np.tile(vr, (len(dims), 1))
+        if vr.shape != (len(dims), 2) or not np.all(vr[:, 1] > vr[:, 0]):
+            raise ValueError(f"value_range must be (low, high) or {len(dims)} rows of (low, high) with "
+                             f"low < high, got {np.asarray(value_range).tolist()}")
+        self.ranges = {d: (float(a), float(b)) for d, (a, b) in zip(dims, vr)}
         z0 = np.zeros(latent_dim) if z0 is None else np.asarray(z0, dtype=np.float64).copy()
         if z0.shape != (latent_dim,):
             raise ValueError(f"z0 must have shape ({latent_dim},), got {z0.shape}")
@@ -333,7 +339,14 @@ class LatentExplorer(_Displayable):
         self.color_by = color_by
         self.seed = seed
         self._rng = np.random.default_rng(seed)
-        self.random_scale = float(random_scale)
+        rs = np.asarray(random_scale, dtype=np.float64)
+        if rs.shape not in ((), (len(dims),)) or np.any(rs < 0):
+            raise ValueError(f"random_scale must be >= 0, a number or {len(dims)} numbers, got {rs.tolist()}")
+        self.random_scale = np.broadcast_to(rs, (len(dims),)).copy()
+        rm = np.zeros(latent_dim) if random_mean is None else np.asarray(random_mean, dtype=np.float64)
+        if rm.shape != (latent_dim,):
+            raise ValueError(f"random_mean must have shape ({latent_dim},), got {rm.shape}")
+        self.random_mean = rm.copy()
         self.n_decodes = 0
         self.last_update_ms = float("nan")
         self._suspended = False
@@ -357,13 +370,14 @@ class LatentExplorer(_Displayable):
 
         self.sliders = {}
         for d in dims:
+            lo, hi = self.ranges[d]
             s = W.FloatSlider(value=float(np.clip(self._z[d], lo, hi)), min=lo, max=hi, step=step,
                               description=f"z[{d}]", continuous_update=bool(continuous_update),
                               readout_format=".2f")
             s.observe(lambda change, d=d: self._on_slider(d, change), names="value")
             self.sliders[d] = s
         self.reset_button = W.Button(description="reset", icon="undo", tooltip="back to z0")
-        self.random_button = W.Button(description="random", icon="random", tooltip=f"draw from N(0, {random_scale}^2), seed {seed}")
+        self.random_button = W.Button(description="random", icon="random", tooltip=f"random draw (seed {seed})")
         self.reset_button.on_click(lambda _: self.reset())
         self.random_button.on_click(lambda _: self.randomize())
         self.status = W.HTML("")
@@ -391,6 +405,51 @@ class LatentExplorer(_Displayable):
         for d, s in self.sliders.items():
             s.add_class(f"meshvae-z{d}")
         self._refresh_status()
+
+    @classmethod
+    def from_encodings(cls, decode, Z, F, n_dims: int = 6, spread: float = 3.0, **kw) -> "LatentExplorer":
+        """An explorer fitted to where the data actually lies in latent space.
+
+        A VAE often leaves many latent dimensions unused (their posterior collapses onto the
+        prior), and a slider on such a dimension changes nothing. This picks the ``n_dims``
+        dimensions along which the encoded training meshes vary most, starts at their mean, gives
+        every slider the range mean +- ``spread`` standard deviations of the data, and draws
+        "random" points from the data's per-dimension normal.
+
+        Parameters
+        ----------
+        decode : callable or model
+            As for :class:`LatentExplorer`.
+        Z : (n_meshes, latent_dim) float
+            Latent means of the training meshes (e.g. ``model.encode_meshes(collection)``).
+        F : (n_faces, 3) int
+        n_dims : int
+            How many sliders.
+        spread : float
+            Slider half-range in data standard deviations.
+        **kw
+            Other :class:`LatentExplorer` arguments (``pad_dims``, ``seed``, ``color_by``, ...).
+
+        Returns
+        -------
+        LatentExplorer
+            ``dims`` sorted by decreasing data variance.
+        """
+        Z = np.asarray(Z, dtype=np.float64)
+        if Z.ndim != 2 or Z.shape[0] < 2:
+            raise ValueError(f"Z must have shape (n_meshes >= 2, latent_dim), got {Z.shape}")
+        n_dims = int(n_dims)
+        if not 1 <= n_dims <= Z.shape[1]:
+            raise ValueError(f"n_dims must be in 1..{Z.shape[1]}, got {n_dims}")
+        mean, std = Z.mean(axis=0), Z.std(axis=0)
+        dims = [int(d) for d in np.argsort(-std, kind="stable")[:n_dims]]
+        half = spread * np.maximum(std[dims], 1e-6)
+        ranges = np.stack([mean[dims] - half, mean[dims] + half], axis=1)
+        kw.setdefault("z0", mean)
+        kw.setdefault("random_mean", mean)
+        kw.setdefault("random_scale", std[dims])
+        kw.setdefault("step", float(np.min(half)) / 50.0)
+        return cls(decode, Z.shape[1], F, dims=dims, value_range=ranges, **kw)
 
     # -- decoding ------------------------------------------------------------------------------
     def _decode_meshes(self, z) -> np.ndarray:
@@ -458,7 +517,7 @@ class LatentExplorer(_Displayable):
         self._suspended = True
         try:
             for d, v in values.items():
-                self.sliders[d].value = float(np.clip(v, *self.value_range))
+                self.sliders[d].value = float(np.clip(v, *self.ranges[d]))
         finally:
             self._suspended = False
 
@@ -482,10 +541,13 @@ class LatentExplorer(_Displayable):
         self.set_z(self.z0)
 
     def randomize(self) -> np.ndarray:
-        """Draw the slider dimensions from N(0, random_scale^2) (seeded); others keep their value."""
+        """Draw the slider dimensions from N(random_mean, random_scale^2) (seeded, clipped to the
+        slider ranges); the other dimensions keep their value."""
         z = self._z.copy()
-        draw = self._rng.standard_normal(len(self.dims)) * self.random_scale
-        z[self.dims] = np.clip(draw, *self.value_range)
+        draw = self.random_mean[self.dims] + self._rng.standard_normal(len(self.dims)) * self.random_scale
+        lo = np.array([self.ranges[d][0] for d in self.dims])
+        hi = np.array([self.ranges[d][1] for d in self.dims])
+        z[self.dims] = np.clip(draw, lo, hi)
         self.set_z(z)
         return self.z
 
