@@ -99,7 +99,8 @@ def student_notebook(nb):
     return out
 
 
-def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3"):
+def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3",
+                     store_widget_state: bool = False):
     """Execute a notebook on a fresh kernel, in its own folder, and return it.
 
     Parameters
@@ -110,6 +111,10 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         Seconds allowed per cell.
     kernel_name : str
         The Jupyter kernel to run it on.
+    store_widget_state : bool
+        Store the widgets' state in the notebook. Off by default: the 3D views' state holds
+        every vertex buffer (megabytes) and an HTML export of it needs the three.js widget code
+        from a CDN; without it each view exports as the PNG snapshot the viewer stores beside it.
     """
     import nbformat
     from nbclient import NotebookClient
@@ -120,7 +125,7 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         timeout=timeout,
         kernel_name=kernel_name,
         resources={"metadata": {"path": str(path.parent)}},
-        store_widget_state=True,
+        store_widget_state=store_widget_state,
     )
     client.execute()
     return nb
