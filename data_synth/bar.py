@@ -1,6 +1,7 @@
 """A bar (an open tube, two boundary loops) that twists and bends far past 180 degrees.
 
-The tube lies along x, length ``BAR_LENGTH`` and radius ``BAR_RADIUS``. A deformation bends its
+The tube lies along x, length ``BAR_LENGTH``, with a rounded-square cross section of half-width
+``BAR_RADIUS`` (a superellipse, so that a twist is visible). A deformation bends its
 centre line into a circular arc of total angle ``bend`` (in the xy plane) and turns its cross
 sections about the centre line by an angle growing linearly from 0 at one end to ``twist`` at
 the other, so the two end rings end up rotated by ``twist`` (and ``bend``) relative to each other.
@@ -72,6 +73,11 @@ def make_bar(seed: int = 0, resolution: int | None = None,
     resolution = C.BAR_DEFAULT_RESOLUTION if resolution is None else int(resolution)
     n_around, n_along = _tube_size(resolution)
     V0, F = grid_tube(n_around, n_along, C.BAR_LENGTH, C.BAR_RADIUS)
+    # a rounded-square cross section (superellipse), so that twisting shows in the geometry
+    theta = np.arctan2(V0[:, 2], V0[:, 1])
+    p = C.BAR_SQUARENESS
+    factor = (np.abs(np.cos(theta)) ** p + np.abs(np.sin(theta)) ** p) ** (-1.0 / p)
+    V0[:, 1:] *= factor[:, None]
     rng = np.random.default_rng(seed)
     chunks, names, motion, frame, tw, bd = [], [], [], [], [], []
     for m, (twist_max, bend_max) in BAR_MOTIONS.items():

@@ -52,6 +52,9 @@ ARM_REST_ANGLE_DEG = 45.0
 BODY_BLEND_RADIUS = 0.035
 #: width (metres) over which skinning weights blend across a joint.
 SKIN_BLEND_WIDTH = 0.12
+#: left/right bones fade out between this distance (metres) on their own side of the body's
+#: midline and the same distance on the other side.
+SKIN_MIDLINE_WIDTH = 0.04
 #: default number of poses in the SCAPE-like collection (the paper's SCAPE has 71).
 SCAPE_N_POSES = 71
 #: default number of frames of the jumping-jacks sequence (Vlasic's Jumping has 150).
@@ -73,4 +76,6 @@ FLAG_N_FRAMES = 100
 BAR_DEFAULT_RESOLUTION = 1000
 BAR_LENGTH = 4.0
 BAR_RADIUS = 0.35
+#: exponent of the bar's superellipse cross section (2: circle; larger: squarer).
+BAR_SQUARENESS = 4.0
 BAR_N_FRAMES_PER_MOTION = 20

@@ -103,7 +103,10 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     out["brow_inner_up"] = np.array([0.0, 0.006, 0.0]) * inner[:, None]
     lips = _gauss(V, (0.0, -0.044, 0.095), (0.02, 0.014, 0.02))
     out["pucker"] = np.stack([-0.3 * x, np.zeros_like(x), 0.009 * np.ones_like(x)], 1) * lips[:, None]
-    out["lip_press"] = np.stack([np.zeros_like(x), -0.002 * np.sign(V[:, 1] + 0.044),
+    # lips press together: the upper lip moves down, the lower up (a smooth step across the
+    # mouth line, never a jump between neighbouring vertices)
+    across = np.tanh((V[:, 1] + 0.044) / 0.006)
+    out["lip_press"] = np.stack([np.zeros_like(x), -0.002 * across,
                                  -0.002 * np.ones_like(x)], 1) * lips[:, None]
     puff = sum(_gauss(V, (s * 0.045, -0.035, 0.055), (0.018, 0.02, 0.025)) for s in (1, -1))
     normals_out = V - np.array([0.0, -0.03, 0.0])

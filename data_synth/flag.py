@@ -53,7 +53,7 @@ def flag_frames(uv: np.ndarray, n_u: int, n_v: int, times: np.ndarray, rng: np.r
     s = strength[:, None, None]
     uu = (u / width)[None, :, None]
     vv = v[None, None, :]
-    amp = (0.35 + 0.6 * s) * uu**0.7  # radians, grows towards the free end
+    amp = (0.45 + 0.65 * s) * uu**0.7  # radians, grows towards the free end
     yaw = amp * np.sin(k * u[None, :, None] - omega * t + kv * vv + phase0[1])
     yaw += 0.25 * (1 - s) * uu * np.sin(0.5 * k * u[None, :, None] - 0.6 * omega * t)
     pitch = (0.55 - 0.4 * s) * uu * (0.7 + 0.3 * vv)  # droops more when the wind drops

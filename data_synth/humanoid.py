@@ -190,7 +190,14 @@ def _cached_template(resolution: int) -> BodyTemplate:
     V, F = polygonize(model, resolution, area_estimate=1.85)
     parts = model.part_of(V)
     skeleton = body_skeleton()
-    W = skinning_weights(V, F, parts, skeleton, C.SKIN_BLEND_WIDTH)
+    # left bones fade out across the midline (to half at x = 0, to zero a few centimetres to the
+    # right) and right bones likewise: the crotch follows both thighs equally and smoothly
+    side = np.array([1.0 if n.startswith("l_") else -1.0 if n.startswith("r_") else 0.0
+                     for n in NAMES])
+    x = np.clip(0.5 + 0.5 * V[:, :1] * side[None] / C.SKIN_MIDLINE_WIDTH, 0.0, 1.0)
+    mask = np.where(side[None] == 0.0, 1.0, x * x * (3.0 - 2.0 * x))
+    W = skinning_weights(V, F, parts, skeleton, C.SKIN_BLEND_WIDTH, relatives_depth=None,
+                         mask=mask)
     for a in (V, F, W, parts):
         a.setflags(write=False)
     return BodyTemplate(V, F, W, parts, skeleton)

@@ -166,10 +166,10 @@ def squat(phase, rng):
     depth = rng.uniform(0.9, 1.05)
     s = depth * (0.5 - 0.5 * np.cos(2.0 * np.pi * 1.5 * phase))
     p = Pose.identity(n)
-    pitch = 0.4 * s
+    pitch = 0.35 * s
     for side in ("l", "r"):
-        # thigh 70 degrees forward, shin 30 degrees back, foot flat: hip, knee, ankle follow
-        p.leg(side, hip=1.2 * s + pitch, knee=1.7 * s, ankle=-0.5 * s, spread=0.1 * s)
+        # thigh 60 degrees forward, shin 30 degrees back, foot flat: hip, knee, ankle follow
+        p.leg(side, hip=1.05 * s + pitch, knee=1.55 * s, ankle=-0.5 * s, spread=0.12 * s)
         p.arm(side, lower=0.7 - 0.25 * s, forward=1.35 * s, elbow=0.2 * s, shrug=0.15 * s)
     p.trunk(bend=0.2 * s, head_nod=-0.5 * s)
     p.root_turn(pitch=pitch)
@@ -248,5 +248,7 @@ def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
         pose.arm(side, lower=u(0.12) - np.abs(u(0.5)), forward=u(0.5), twist=u(0.4),
                  elbow=np.abs(u(0.6)))
         pose.leg(side, hip=u(0.25), knee=np.abs(u(0.3)), spread=np.abs(u(0.1)))
-    pose.trunk(bend=u(0.3), twist=u(0.4), side=u(0.2), head_nod=u(0.3), head_turn=u(0.5))
+    # bending and nodding mostly forward (backwards pinches the back of the neck)
+    pose.trunk(bend=rng.uniform(-0.1, 0.3, size=n), twist=u(0.4), side=u(0.2),
+               head_nod=rng.uniform(-0.12, 0.3, size=n), head_turn=u(0.5))
     return pose, chosen

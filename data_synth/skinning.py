@@ -2,8 +2,9 @@
 
 Weights start from each vertex's *part* (the bone of the implicit primitive that made the surface
 there), are diffused over the mesh (so they blend smoothly across joints, over a width given in
-metres) and are then restricted to the part's relatives (ancestors and descendants up to two
-generations, never siblings), so one thigh never pulls the other. Posing uses dual-quaternion skinning (Kavan et al. 2007), which does not
+metres, and never jump across a gap between two parts as distance-based weights do) and can
+then be restricted to the part's relatives (ancestors and descendants up to two generations,
+never siblings) or by a mask. Posing uses dual-quaternion skinning (Kavan et al. 2007), which does not
 collapse a twisting wrist or a raised shoulder the way linear blend skinning does ("candy
 wrapper"); :func:`linear_blend` is kept for affine maps (body-shape changes) and for comparison.
 """
@@ -20,7 +21,8 @@ __all__ = ["skinning_weights", "linear_blend", "dual_quaternion_blend"]
 
 
 def skinning_weights(V: np.ndarray, F: np.ndarray, parts: np.ndarray, skeleton: Skeleton,
-                     blend_width: float, max_influences: int = 4) -> np.ndarray:
+                     blend_width: float, max_influences: int = 4,
+                     relatives_depth: int | None = 2, mask: np.ndarray | None = None) -> np.ndarray:
     """Smooth skinning weights.
 
     Parameters
@@ -31,6 +33,10 @@ def skinning_weights(V: np.ndarray, F: np.ndarray, parts: np.ndarray, skeleton: 
     skeleton : Skeleton
     blend_width : float, distance over which weights blend across a joint (same unit as V).
     max_influences : int, bones kept per vertex.
+    relatives_depth : int or None, keep only bones within this many generations of the vertex's
+        part (None: no restriction; the diffusion over the surface already keeps weights local).
+    mask : (n_vertices, n_joints) float64 in [0, 1], optional, multiplies the diffused weights
+        (the body uses it to keep each thigh's weight on its own side of the crotch).
 
     Returns
     -------
@@ -46,10 +52,14 @@ def skinning_weights(V: np.ndarray, F: np.ndarray, parts: np.ndarray, skeleton: 
     iterations = int(np.clip(np.ceil(2.0 * (blend_width / mean_edge) ** 2), 1, 400))
     for _ in range(iterations):
         W = 0.5 * W + 0.5 * (A @ W) / deg[:, None]
-    allowed = np.zeros((J, J), dtype=bool)
-    for j, nb in enumerate(skeleton.relatives(depth=2)):
-        allowed[j, list(nb)] = True
-    W *= allowed[parts]
+    if relatives_depth is not None:
+        allowed = np.zeros((J, J), dtype=bool)
+        for j, nb in enumerate(skeleton.relatives(depth=relatives_depth)):
+            allowed[j, list(nb)] = True
+        W *= allowed[parts]
+    if mask is not None:
+        W *= mask
+    W[np.arange(n), parts] += 1e-12  # never an empty row
     if max_influences < J:
         cutoff = -np.sort(-W, axis=1)[:, max_influences - 1 : max_influences]
         W[W < cutoff] = 0.0
