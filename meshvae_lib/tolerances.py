@@ -115,7 +115,7 @@ DEFAULT_EPOCHS = 1000
 #: meshes per Adam step.
 DEFAULT_BATCH_SIZE = 32
 #: internal layer sizes for the coordinate baselines of Table 3 (RIMD uses none).
-HIDDEN_COORDS = (512,)
+HIDDEN_COORDS = (256,)
 
 # --- viewing (meshvae_lib.viewing) -----------------------------------------------------------
 #: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
