@@ -88,7 +88,7 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1."""
     x = V[:, 0]
     front = _smoothstep((V[:, 2] - 0.03) / 0.04)
-    sx = np.sign(x)
+    sx = np.tanh(x / 0.012)  # a smooth 'which side' (a sign would tear the midline)
     out = {}
     corner = sum(_gauss(V, (s * 0.026, -0.044, 0.092), (0.014, 0.012, 0.02)) for s in (1, -1))
     out["smile"] = np.stack([0.006 * sx, 0.007 * np.ones_like(x), -0.004 * np.ones_like(x)], 1) * corner[:, None]

@@ -148,7 +148,7 @@ def make_hand(seed: int = 0, resolution: int | None = None,
                                    wrist + rng.uniform(-0.15, 0.15), ramp)
         R, p = forward_kinematics(skeleton, local, np.zeros((len(ramp), 3)))
         t = p - np.einsum("njab,jb->nja", R, skeleton.rest)
-        chunks.append(dual_quaternion_blend(np.asarray(V0), W, R, t))
+        chunks.append(dual_quaternion_blend(np.asarray(V0), W, R, t, parents=skeleton.parents))
         for f in range(frames_per_gesture):
             names.append(f"{g}_{f:02d}")
             gesture.append(g)

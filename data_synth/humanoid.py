@@ -311,4 +311,4 @@ def pose_body(V_rest: np.ndarray, joints_rest: np.ndarray, template: BodyTemplat
     """
     R, p = forward_kinematics(template.skeleton, local, root_translation, rest=joints_rest)
     t = p - np.einsum("njab,jb->nja", R, joints_rest)
-    return dual_quaternion_blend(V_rest, template.W, R, t)
+    return dual_quaternion_blend(V_rest, template.W, R, t, parents=template.skeleton.parents)

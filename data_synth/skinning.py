@@ -94,7 +94,8 @@ def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.concatenate([v, w], axis=-1)
 
 
-def dual_quaternion_blend(V: np.ndarray, W: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+def dual_quaternion_blend(V: np.ndarray, W: np.ndarray, R: np.ndarray, t: np.ndarray,
+                          parents: np.ndarray | None = None) -> np.ndarray:
     """Dual-quaternion skinning of rigid bone transforms ``x -> R_j x + t_j``.
 
     Parameters
@@ -103,6 +104,10 @@ def dual_quaternion_blend(V: np.ndarray, W: np.ndarray, R: np.ndarray, t: np.nda
     W : (n_vertices, n_joints) float64, skinning weights.
     R : (n_frames, n_joints, 3, 3) float64, rotations.
     t : (n_frames, n_joints, 3) float64, translations.
+    parents : (n_joints,) int64, optional. A quaternion and its negative are the same rotation;
+        blending needs them on one side. With ``parents`` every bone's quaternion is put on its
+        parent's side (one choice for the whole mesh, so the result is continuous across it);
+        without, each vertex aligns the signs with its main bone.
 
     Returns
     -------
@@ -111,13 +116,20 @@ def dual_quaternion_blend(V: np.ndarray, W: np.ndarray, R: np.ndarray, t: np.nda
     n_frames, J = R.shape[:2]
     qr = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(n_frames, J, 4)
     tq = np.concatenate([t, np.zeros((n_frames, J, 1))], axis=-1)
+    if parents is not None:
+        for j in range(1, J):  # about 20 bones, vectorised over frames
+            flip = np.sum(qr[:, j] * qr[:, parents[j]], axis=-1) < 0
+            qr[flip, j] *= -1.0
     qd = 0.5 * _quat_mul(tq, qr)
-    pivot = np.argmax(W, axis=1)  # each vertex aligns signs with its main bone
+    pivot = np.argmax(W, axis=1)
     out = np.empty((n_frames, len(V), 3))
     for f in range(n_frames):  # loop over frames, vectorised over vertices and bones
-        sign = np.sign(qr[f, pivot] @ qr[f].T)  # (n_vertices, J)
-        sign[sign == 0] = 1.0
-        Ws = W * sign
+        if parents is None:
+            sign = np.sign(qr[f, pivot] @ qr[f].T)  # (n_vertices, J)
+            sign[sign == 0] = 1.0
+            Ws = W * sign
+        else:
+            Ws = W
         br = Ws @ qr[f]
         bd = Ws @ qd[f]
         norm = np.linalg.norm(br, axis=1, keepdims=True)
