@@ -25,8 +25,9 @@ from meshvae_lib.evaluation import evaluate_model
 from meshvae_lib.training import TrainConfig
 
 
-def run_one(coll, kind: str, hidden, epochs: int, every: int, seed: int, latent: int):
-    cfg = TrainConfig(epochs=epochs, hidden=hidden, seed=seed, latent_dim=latent, progress=False)
+def run_one(coll, kind: str, hidden, epochs: int, every: int, seed: int, latent: int, batch_size: int, lr: float):
+    cfg = TrainConfig(epochs=epochs, hidden=hidden, seed=seed, latent_dim=latent, progress=False,
+                      batch_size=batch_size, lr=lr)
     t0 = time.perf_counter()
     model = MeshVAEModel(kind, cfg, holdout_every=every).fit(coll)
     seconds = time.perf_counter() - t0  # features + training
@@ -47,6 +48,8 @@ def main() -> None:
     ap.add_argument("--coords-hidden", default="none,256",
                     help="layer settings tried for the coordinate baselines, e.g. 'none,256,1024-256'")
     ap.add_argument("--rimd-hidden", default="none", help="layer settings tried for RIMD, e.g. 'none,256'")
+    ap.add_argument("--batch-size", type=int, default=TrainConfig().batch_size)
+    ap.add_argument("--lr", type=float, default=TrainConfig().lr)
     ap.add_argument("--kinds", default="coords,aligned,rimd", help="feature kinds to run")
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
@@ -59,7 +62,8 @@ def main() -> None:
     diag = float(np.mean(np.linalg.norm(np.ptp(coll.vertices, axis=1), axis=1)))
     print(f"collection {args.collection!r}: {coll.vertices.shape[0]} meshes, {coll.vertices.shape[1]} vertices,"
           f" mean bounding-box diagonal {diag:.4g}; held out every {args.holdout_every}th;"
-          f" {epochs} epochs, latent {args.latent}, {torch.get_num_threads()} threads\n")
+          f" {epochs} epochs, batch {args.batch_size}, lr {args.lr:g}, latent {args.latent},"
+          f" {torch.get_num_threads()} threads\n")
     settings = [("coords", h) for h in args.coords_hidden.split(",")] + \
                [("aligned", h) for h in args.coords_hidden.split(",")] + \
                [("rimd", h) for h in args.rimd_hidden.split(",")]
@@ -68,7 +72,8 @@ def main() -> None:
     print(f"{'features':9s} {'hidden':>9s} {'K':>7s} {'held-out error':>15s} {'% diag':>8s} {'train error':>12s} {'time (s)':>9s}")
     for kind, h in settings:
         hidden = () if h == "none" else tuple(int(x) for x in h.split("-"))
-        res, train_err, seconds, model = run_one(coll, kind, hidden, epochs, args.holdout_every, args.seed, args.latent)
+        res, train_err, seconds, model = run_one(coll, kind, hidden, epochs, args.holdout_every, args.seed, args.latent,
+                                                  args.batch_size, args.lr)
         rows.append((kind, h, res["mean_vertex_error"], seconds))
         print(f"{kind:9s} {h:>9s} {model.network_.n_features:7d} {res['mean_vertex_error']:15.5g}"
               f" {100 * res['relative_error']:8.3f} {train_err:12.5g} {seconds:9.1f}", flush=True)
