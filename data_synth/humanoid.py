@@ -190,11 +190,15 @@ def _cached_template(resolution: int) -> BodyTemplate:
     V, F = polygonize(model, resolution, area_estimate=1.85)
     parts = model.part_of(V)
     skeleton = body_skeleton()
-    # left bones fade out across the midline (to half at x = 0, to zero a few centimetres to the
-    # right) and right bones likewise: the crotch follows both thighs equally and smoothly
+    # left bones act on the left, right bones on the right. Leg bones fade out across the
+    # midline (half at x = 0, so the crotch follows both thighs equally); arm bones (clavicles
+    # and below) fade to zero at the midline, so two shrugging clavicles never pull the same
+    # skin at the back of the neck in opposite directions.
     side = np.array([1.0 if n.startswith("l_") else -1.0 if n.startswith("r_") else 0.0
                      for n in NAMES])
-    x = np.clip(0.5 + 0.5 * V[:, :1] * side[None] / C.SKIN_MIDLINE_WIDTH, 0.0, 1.0)
+    leg = np.array([n[2:] in ("thigh", "shin", "foot") for n in NAMES])
+    u = V[:, :1] * side[None] / C.SKIN_MIDLINE_WIDTH
+    x = np.clip(np.where(leg[None], 0.5 + 0.5 * u, u), 0.0, 1.0)
     mask = np.where(side[None] == 0.0, 1.0, x * x * (3.0 - 2.0 * x))
     W = skinning_weights(V, F, parts, skeleton, C.SKIN_BLEND_WIDTH, relatives_depth=None,
                          mask=mask)
