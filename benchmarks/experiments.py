@@ -108,6 +108,17 @@ def _jsonable(table) -> dict:
             "notes": table.notes, "seconds": table.seconds}
 
 
+def _write_summary(out, args, settings, total, parts, results, failed, done: bool) -> None:
+    """summary.md and results.json (rewritten after every experiment, so a cut run keeps its tables)."""
+    state = "" if done else " (in progress)"
+    header = (f"# Experiments ({'quick' if args.quick else 'full'} size){state}\n\n"
+              f"Total time: {total:.0f} s on {os.cpu_count()} CPU core(s), torch threads {args.threads}.\n\n"
+              f"Settings: `{dataclasses.asdict(settings)}`\n\n")
+    (out / "summary.md").write_text(header + "\n".join(parts))
+    (out / "results.json").write_text(json.dumps({"settings": dataclasses.asdict(settings), "seconds": total,
+                                                  "done": done, "failed": failed, "tables": results}, indent=1))
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", default="build/experiments", help="output folder")
@@ -155,13 +166,9 @@ def main(argv=None) -> int:
         parts.append(f"## {key}\n\n{md}\n\n" + "".join(f"![{f}]({f})\n" for f in files))
         print(md, flush=True)
         print(f"   ({table.seconds:.0f} s)", flush=True)
+        _write_summary(out, args, settings, time.perf_counter() - t_all, parts, results, failed, done=False)
     total = time.perf_counter() - t_all
-    header = (f"# Experiments ({'quick' if args.quick else 'full'} size)\n\n"
-              f"Total time: {total:.0f} s on {os.cpu_count()} CPU core(s), torch threads {args.threads}.\n\n"
-              f"Settings: `{dataclasses.asdict(settings)}`\n\n")
-    (out / "summary.md").write_text(header + "\n".join(parts))
-    (out / "results.json").write_text(json.dumps({"settings": dataclasses.asdict(settings), "seconds": total,
-                                                  "failed": failed, "tables": results}, indent=1))
+    _write_summary(out, args, settings, total, parts, results, failed, done=True)
     print(f"wrote {out}/summary.md ({total:.0f} s); failed: {failed or 'none'}", flush=True)
     return 1 if failed else 0
 

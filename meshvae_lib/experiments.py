@@ -93,9 +93,9 @@ class ExperimentSettings:
     seed : seeds data, initial weights, shuffling and sampling
     """
 
-    resolution: int | None = 600
-    max_meshes: int | None = 240
-    train_steps: int = 600
+    resolution: int | None = 400
+    max_meshes: int | None = 210
+    train_steps: int = 300
     min_epochs: int = 20
     max_epochs: int = 600
     batch_size: int = 32
@@ -245,7 +245,7 @@ def load_collection(entry, settings: ExperimentSettings | None = None, resolutio
     return data
 
 
-def _stable_vae_class(sigmoid_output: bool = False):
+def _stable_vae_class(sigmoid_output: bool = False, noise_scale=None):
     """MeshVAE with ``sigma = sigma_max * sigmoid(s) + SIGMA_FLOOR`` (optionally a sigmoid output).
 
     With the paper's alpha = 1e6 the reconstruction term drives the posterior deviation towards 0;
@@ -253,6 +253,16 @@ def _stable_vae_class(sigmoid_output: bool = False):
     ``log(sigma^2)`` becomes -inf and training turns to NaN (measured: epoch 78 of 300 on a
     160-mesh body collection). A floor of ``tolerances.SIGMA_FLOOR`` keeps every term finite and
     changes nothing measurable otherwise.
+
+    ``noise_scale`` (D,) gives the *paper's* sigma_object prior (Sec. 4.4, as the authors' sibling
+    code writes it, see ``docs/applications.md``): the encoder reports ``sigma' = sigma /
+    sigma_object`` to the standard KL, and the sample is ``z = mu + sigma_object * sigma' * eps``.
+    Then the standard KL of ``(mu, sigma')`` is exactly
+    ``1/2 [mu^2 + (sigma/sigma_object)^2 - log (sigma/sigma_object)^2 - 1]``: small sigma_object
+    makes a dimension's posterior narrow (a precise, cheap channel for the dominant variation)
+    while its means keep the unit spread the paper browses in [-2, 2]. (The exact KL to
+    N(0, diag sigma_object^2) is invariant under z_i -> z_i / sigma_object_i, which the linear
+    decoder absorbs, so on its own it does not single out the chosen dimensions.)
     """
     import torch
 
@@ -262,6 +272,12 @@ def _stable_vae_class(sigmoid_output: bool = False):
         def encode(self, x, c=None):
             mu, sigma = super().encode(x, c)
             return mu, sigma + tol.SIGMA_FLOOR
+
+        if noise_scale is not None:
+
+            def reparameterize(self, mu, sigma, generator=None):
+                scale = torch.as_tensor(np.asarray(noise_scale), dtype=mu.dtype, device=mu.device)
+                return super().reparameterize(mu, sigma * scale, generator)
 
         if sigmoid_output:
 
@@ -273,8 +289,12 @@ def _stable_vae_class(sigmoid_output: bool = False):
     return StableMeshVAE
 
 
-def _fit(model, collection):
-    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class`` (same steps otherwise)."""
+def _fit(model, collection, noise_scale=None):
+    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class`` (same steps otherwise).
+
+    ``noise_scale``: train with the paper's sigma_object prior (see ``_stable_vae_class``); the
+    config's own ``sigma_object`` must then be None.
+    """
     import torch
 
     from meshvae_lib.features import ConditionEncoder, FeatureExtractor
@@ -300,7 +320,7 @@ def _fit(model, collection):
     n_cond = 0 if C is None else C.shape[1]
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
-        net = _stable_vae_class()(Xn.shape[1], config.latent_dim, config.hidden, n_cond)
+        net = _stable_vae_class(noise_scale=noise_scale)(Xn.shape[1], config.latent_dim, config.hidden, n_cond)
     result = train_vae(
         Xn[~mask], None if C is None else C[~mask], config,
         val_features=Xn[mask] if mask.any() else None,
@@ -314,12 +334,21 @@ def _fit(model, collection):
     model.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
     so = pad_sigma_object(config.sigma_object, model.network_.latent_dim)
     model.sigma_object_ = np.ones(model.network_.latent_dim) if so is None else so
+    model.noise_scale_ = None if noise_scale is None else np.asarray(noise_scale, dtype=np.float64)
     return model
 
 
 def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_extra=(), *, features="rimd",
-           latent_dim=None, sigma_object=None, labels=(), reference_index=0, holdout=True, epochs=None):
-    """A trained MeshVAEModel (from the cache when the same model was trained already)."""
+           latent_dim=None, sigma_object=None, labels=(), reference_index=0, holdout=True, epochs=None,
+           prior: str = "paper"):
+    """A trained MeshVAEModel (from the cache when the same model was trained already).
+
+    ``prior`` (only with ``sigma_object``): "paper" -- the authors' form of the sigma_object KL
+    (posterior widths shrink, means keep unit spread; see ``_stable_vae_class``), or "exact" --
+    the library's exact KL to N(0, diag sigma_object^2) (``vae.kl_divergence``).
+    """
+    if prior not in ("paper", "exact"):
+        raise ValueError(f"prior must be 'paper' or 'exact', got {prior!r}")
     from meshvae_lib.checkpoint import MeshVAEModel
     from meshvae_lib.training import TrainConfig, default_hidden, holdout_mask
 
@@ -330,14 +359,20 @@ def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_ex
     ep = settings.epochs_for(n_train) if epochs is None else int(epochs)
     so = None if sigma_object is None else tuple(float(s) for s in sigma_object)
     key = ("model", key_extra, id(coll), features, latent, so, tuple(labels), reference_index, every, ep,
-           settings.layout, settings.seed, settings.batch_size, hidden)
+           settings.layout, settings.seed, settings.batch_size, hidden, prior if so else None)
     if cache is not None and key in cache:
         return cache[key]
-    cfg = TrainConfig(epochs=ep, batch_size=settings.batch_size, latent_dim=latent, hidden=hidden, sigma_object=so,
-                      seed=settings.seed, device="cpu", progress=False)
+    paper_prior = so is not None and prior == "paper"
+    cfg = TrainConfig(epochs=ep, batch_size=settings.batch_size, latent_dim=latent, hidden=hidden,
+                      sigma_object=None if paper_prior else so, seed=settings.seed, device="cpu", progress=False)
     model = MeshVAEModel(features=features, config=cfg, labels=labels, holdout_every=every,
                          layout=settings.layout, reference_index=reference_index)
-    model = _fit(model, coll)
+    noise = None
+    if paper_prior:
+        from meshvae_lib.training import pad_sigma_object
+
+        noise = pad_sigma_object(so, latent)
+    model = _fit(model, coll, noise_scale=noise)
     if cache is not None:
         cache[key] = model
     return model
@@ -625,7 +660,7 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
 
 @_timed
 def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"), relevance: str = "each",
-                    settings: ExperimentSettings | None = None, quick: bool = False,
+                    compare_exact: bool = True, settings: ExperimentSettings | None = None, quick: bool = False,
                     cache: dict | None = None) -> ExperimentTable:
     """Sec. 5.4: 2D embeddings and their retrieval precision-recall AUC.
 
@@ -643,7 +678,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
         raise ValueError(f"collection {_name_of(collection)!r} has none of the label columns {label_columns};"
                          f" it has {sorted(coll.labels)}")
     D = s.latent_dim
-    model = _train(coll, s, cache, sigma_object=emb.embedding_sigma_object(D), holdout=False)
+    model = _train(coll, s, cache, sigma_object=emb.embedding_sigma_object(D), holdout=False, prior="paper")
     X = model.features_of(coll.vertices)
     k = min(tol.NPE_N_NEIGHBORS, len(X) - 1)
     Y = {
@@ -660,9 +695,18 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
         joint = emb.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
         curves[m] = res
         table.rows.append([m, res.auc["mean"]] + [res.auc[c] for c in labels] + [joint, PAPER["auc"].get(m)])
+    if compare_exact:
+        exact = _train(coll, s, cache, sigma_object=emb.embedding_sigma_object(D), holdout=False, prior="exact")
+        y = exact.encode_meshes(coll.vertices)[:, :2]
+        res = emb.precision_recall_curve(y, labels, relevance=relevance)
+        joint = emb.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
+        table.rows.append(["sigma_object VAE, exact KL"] + [res.auc["mean"]] + [res.auc[c] for c in labels]
+                          + [joint, None])
+        Y["sigma_object VAE, exact KL"] = y
+        curves["sigma_object VAE, exact KL"] = res
     table.data.update(embeddings=Y, labels=labels, curves=curves)
     ours = table.rows[0][1]
-    others = {r[0]: r[1] for r in table.rows[1:]}
+    others = {r[0]: r[1] for r in table.rows[1:4]}
     table.data["ours_minus"] = {m: ours - a for m, a in others.items()}
     table.notes.append(f"N = {len(X)} meshes; relevance = {relevance!r} (one retrieval task per label, AUCs averaged)."
                        f" Ours minus t-SNE: {ours - others['t-SNE']:+.4f}, minus PCA: {ours - others['PCA']:+.4f},"
@@ -796,7 +840,8 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
-    model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False)
+    model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
+                   prior="paper")
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
     regions = ex.humanoid_regions(rest)
     measure = lambda V: ex.measure_humanoid(V, regions)  # noqa: E731

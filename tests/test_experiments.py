@@ -145,7 +145,7 @@ def test_loss_table(coll, cache):
 
 def test_embedding_table(coll, cache):
     t = exps.embedding_table(coll, settings=SETTINGS, cache=cache)
-    assert t.column("method") == ["sigma_object VAE", "t-SNE", "PCA", "NPE"]
+    assert t.column("method") == ["sigma_object VAE", "t-SNE", "PCA", "NPE", "sigma_object VAE, exact KL"]
     aucs = np.array(t.column("AUC (mean)"), dtype=float)
     assert np.all((aucs > 0) & (aucs <= 1))
     # the table's number is the retrieval AUC of the stored embedding
@@ -155,6 +155,7 @@ def test_embedding_table(coll, cache):
     assert retrieval_auc(Y, t.data["labels"]) == pytest.approx(aucs[2], abs=1e-12)
     assert t.data["embeddings"]["NPE"].shape == (40, 2)
     assert t.rows[0][-1] == pytest.approx(0.5168)
+    assert t.data["ours_minus"]["PCA"] == pytest.approx(aucs[0] - aucs[2], abs=1e-12)
     assert t.plot().axes
 
 
@@ -177,3 +178,21 @@ def test_interpolation_table(coll, cache):
     np.testing.assert_allclose(seqs["linear coordinates"][0], coll.vertices[a], atol=1e-12)
     assert all(s.shape == (4, 42, 3) for s in seqs.values())
     assert all(isinstance(r[1], int) and r[3] >= 0 for r in t.rows)
+
+
+def test_paper_prior_network_scales_only_the_sample():
+    import torch
+
+    scale = np.array([0.1, 0.5, 1.0])
+    net = exps._stable_vae_class(noise_scale=scale)(6, 3)
+    mu = torch.zeros(4, 3)
+    sigma = torch.full((4, 3), 0.5)
+    g1, g2 = torch.Generator().manual_seed(3), torch.Generator().manual_seed(3)
+    z = net.reparameterize(mu, sigma, g1)
+    eps = torch.randn((4, 3), generator=g2)
+    np.testing.assert_allclose(z.numpy(), (0.5 * eps * torch.as_tensor(scale, dtype=torch.float32)).numpy(), atol=1e-7)
+    # the deviation the KL sees has the floor, never 0
+    _, s = net.encode(torch.full((2, 6), -1e4))
+    assert torch.all(s >= exps.tol.SIGMA_FLOOR)
+    with pytest.raises(ValueError, match="prior"):
+        exps._train(exps.load_collection(_make(), SETTINGS), SETTINGS, None, sigma_object=(0.1,), prior="x")
