@@ -3,6 +3,8 @@ triangles in any frame, edge lengths within bounds of the rest pose, and the bar
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 import trimesh
@@ -19,9 +21,15 @@ CLOSED = {"scape", "dyna", "jumping", "hand", "face"}
 N_LOOPS = {"flag": 1, "bar": 2, **{n: 0 for n in CLOSED}}
 
 
+@functools.lru_cache(maxsize=None)
+def built(name: str, seed: int = 0, resolution: int | None = None):
+    """Collections built once per test session (the registry tests share them)."""
+    return make_collection(name, seed=seed, resolution=resolution)
+
+
 @pytest.fixture(scope="module")
 def collections():
-    return {name: make_collection(name, seed=0) for name in NAMES}
+    return {name: built(name) for name in NAMES}
 
 
 def rest_per_mesh(col) -> np.ndarray:

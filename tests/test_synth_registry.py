@@ -13,6 +13,7 @@ from data_synth.bodies import DYNA_SHAPES
 from data_synth.face import EXPRESSIONS
 from data_synth.hand import GESTURES
 from data_synth.motions import MOTIONS
+from test_synth_geometry import built  # pytest puts tests/ on sys.path
 
 NAMES = [n for n, _ in list_collections()]
 #: small templates keep these tests fast; geometry tests use the default sizes
@@ -45,7 +46,7 @@ def test_deterministic_for_a_seed_and_different_across_seeds(name):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_default_sizes_and_types(name):
-    col = make_collection(name)
+    col = built(name)  # the default collection, shared with the geometry tests
     N, V, _ = col.vertices.shape
     assert 500 <= V <= 3000, f"{name}: {V} vertices"
     assert 20 <= N <= 250, f"{name}: {N} meshes"
