@@ -499,6 +499,8 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
         for k in kinds:
             errs[k] = _heldout_error(_train(coll, s, cache, features=k), coll)["mean_vertex_error"]
         table.data["errors"][name] = errs
+        logger.info("table 3, %s [%d meshes]: %s", name, len(coll.vertices),
+                    ", ".join(f"{k} {v:.4e}" for k, v in errs.items()))
         red_c = 1 - errs["rimd"] / errs["coords"] if "coords" in errs and "rimd" in errs else None
         red_a = 1 - errs["rimd"] / errs["aligned"] if "aligned" in errs and "rimd" in errs else None
         paper = PAPER["table3"].get(name)
