@@ -126,6 +126,7 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         kernel_name=kernel_name,
         resources={"metadata": {"path": str(path.parent)}},
         store_widget_state=store_widget_state,
+        record_timing=False,
     )
     client.execute()
     return nb
