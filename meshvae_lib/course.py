@@ -120,6 +120,8 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
+    for cell in nb.cells:  # timestamps of an earlier run would only churn the committed file
+        cell.metadata.pop("execution", None)
     client = NotebookClient(
         nb,
         timeout=timeout,
