@@ -79,7 +79,7 @@ def _renderings(table, out: Path) -> list[str]:
         n = len(next(iter(seqs.values())))
         meshes = np.concatenate([seqs[m] for m in names])
         imp = d["implausibility"]
-        titles = [f"{m}: step {i} ({imp.self_intersections[m][i]} x)" for m in names for i in range(n)]
+        titles = [f"{m.split()[0]} {i}: {imp.self_intersections[m][i]}x" for m in names for i in range(n)]
         _save(render_mesh_grid(meshes, d["faces"], titles=titles, ncols=n, size=1.8,
                                suptitle="rows: " + " / ".join(names) + "   (x: crossing triangle pairs)"),
               out / "interpolation_meshes.png")
