@@ -117,11 +117,13 @@ class GenerationResult:
 
     def novelty_ratio(self) -> np.ndarray:
         """(n,) float64: each generated mesh's nearest distance over the median training-set
-        nearest-neighbour distance (about 1: as new as a training mesh is to the others; near 0: a
+        nearest-neighbour distance (exact duplicates in the training set left out) (about 1: as new as a training mesh is to the others; near 0: a
         copy)."""
         if self.distance is None or self.dataset_nn_distance is None:
             raise ValueError("no nearest neighbours were computed (generate(..., dataset=None))")
-        return self.distance / np.median(self.dataset_nn_distance)
+        d = self.dataset_nn_distance
+        d = d[d > 1e-9 * max(float(d.max()), 1e-300)]  # exact duplicates (e.g. shared rest frames) say nothing
+        return self.distance / (np.median(d) if d.size else np.nan)
 
     def rows(self) -> list[dict]:
         out = []
