@@ -1,0 +1,92 @@
+"""The course's notebooks follow the course's rules (docs/NOTEBOOKS.md).
+
+nbval checks that each notebook runs and reproduces its stored outputs; these tests check the shape
+of each lesson: objectives at the top, a parameters cell, exercises with solutions and
+self-checks at the end, stored outputs without errors or noise.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from meshvae_lib.course import BEGIN_SOLUTION, END_SOLUTION, student_notebook
+
+NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
+NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
+NOISE = re.compile(r"Warning|warn\(|DEPRECAT|Traceback|INFO:|DEBUG:", re.IGNORECASE)
+
+
+def test_the_course_has_its_eleven_numbered_notebooks():
+    numbers = [p.name[:2] for p in NOTEBOOKS]
+    assert numbers == [f"{i:02d}" for i in range(11)], [p.name for p in NOTEBOOKS]
+    for p in NOTEBOOKS:
+        assert re.fullmatch(r"\d\d_[a-z0-9_]+\.ipynb", p.name), p.name
+
+
+@pytest.fixture(params=NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def nb(request):
+    return nbformat.read(request.param, as_version=4)
+
+
+def _text(cell) -> str:
+    return cell.source if isinstance(cell.source, str) else "".join(cell.source)
+
+
+def test_opens_with_objectives_and_prerequisites(nb):
+    first = nb.cells[0]
+    assert first.cell_type == "markdown"
+    text = _text(first).lower()
+    assert text.startswith("# "), "the first cell is the lesson's title"
+    assert "what you will learn" in text
+    assert "what you need" in text
+
+
+def test_has_a_parameters_cell_near_the_top(nb):
+    code = [c for c in nb.cells if c.cell_type == "code"][:4]
+    assert any(
+        "parameters" in c.metadata.get("tags", []) and _text(c).startswith("# Parameters") for c in code
+    ), "one of the first code cells must be tagged 'parameters' and start with '# Parameters'"
+
+
+def test_ends_with_summary_and_exercises(nb):
+    headings = [_text(c).lower() for c in nb.cells if c.cell_type == "markdown"]
+    i_summary = max((i for i, t in enumerate(headings) if "## summary" in t), default=-1)
+    i_exercises = max((i for i, t in enumerate(headings) if "## exercises" in t), default=-1)
+    assert i_summary >= 0 and i_exercises >= 0, "needs '## Summary' and '## Exercises' sections"
+    assert i_summary < i_exercises or i_summary == i_exercises
+    assert i_exercises >= len(headings) - 8, "the exercises come at the end"
+
+
+def test_every_solution_is_followed_by_a_self_check(nb):
+    cells = nb.cells
+    n_solutions = 0
+    for i, cell in enumerate(cells):
+        if cell.cell_type != "code" or BEGIN_SOLUTION not in _text(cell):
+            continue
+        n_solutions += 1
+        assert _text(cell).count(BEGIN_SOLUTION) == _text(cell).count(END_SOLUTION)
+        later = [c for c in cells[i + 1 :] if c.cell_type == "code"]
+        assert later and "assert" in _text(later[0]), f"no self-check after the solution in cell {i}"
+    assert n_solutions >= 1, "each lesson ends with at least one exercise"
+    student = student_notebook(nb)
+    assert all(BEGIN_SOLUTION not in _text(c) for c in student.cells)
+
+
+def test_is_committed_with_outputs_and_without_noise(nb):
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert all(c.execution_count is not None for c in code), "run `make notebooks` before committing"
+    for c in code:
+        for out in c.outputs:
+            assert out.output_type != "error", _text(c)
+            if out.output_type == "stream":
+                assert out.name == "stdout", f"stderr output in cell:\n{_text(c)}\n{out.text}"
+                assert not NOISE.search(out.text), out.text
+
+
+def test_markdown_refers_to_the_paper(nb):
+    markdown = "\n".join(_text(c) for c in nb.cells if c.cell_type == "markdown")
+    assert re.search(r"(Eq\.|Sec\.|Fig\.|Table)\s*\(?\d", markdown), "point to the paper by number"
