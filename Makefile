@@ -33,8 +33,9 @@ venv: $(STAMP)
 browser:
 	@bash .ci/install-chromium.sh
 
+# JupyterLab refuses to run as root without --allow-root (containers, cloud machines).
 lab: $(STAMP)
-	$(BIN)/jupyter lab notebooks/
+	$(BIN)/jupyter lab notebooks/ $(if $(filter 0,$(shell id -u)),--allow-root)
 
 test: $(STAMP) browser
 	$(BIN)/python -m pytest tests notebooks $(PYTEST_NB)
