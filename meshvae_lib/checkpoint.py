@@ -110,11 +110,17 @@ class MeshVAEModel:
         self.reference_index = reference_index
 
     # -- training ------------------------------------------------------------------------------
-    def fit(self, collection) -> "MeshVAEModel":
+    def fit(self, collection, network=None) -> "MeshVAEModel":
         """Extract features, normalise them, train the network.
 
         collection : a MeshCollection / SynthCollection (``vertices (N, n, 3)``, ``faces (F, 3)``,
-        ``labels``). Returns ``self``.
+        ``labels``).
+        network : callable, optional
+            ``network(n_features, latent_dim, hidden, n_conditions) -> MeshVAE`` (a subclass, e.g.
+            with another output layer or prior); built with the config's seed. Default: ``MeshVAE``
+            as :func:`~meshvae_lib.training.train_vae` builds it.
+
+        Returns ``self``.
         """
         config = self.config or TrainConfig()
         V = np.asarray(collection.vertices, dtype=np.float64)
@@ -134,10 +140,16 @@ class MeshVAEModel:
             raise ValueError(f"no label column(s) {missing}; the data has {sorted(labels)}")
         self.conditions_ = ConditionEncoder(self.labels).fit({c: np.asarray(labels[c])[~mask] for c in self.labels})
         C = self.conditions_.transform(labels) if self.labels else None
+        net = None
+        if network is not None:
+            with torch.random.fork_rng(devices=[]):
+                torch.manual_seed(config.seed)
+                net = network(Xn.shape[1], config.latent_dim, config.hidden, 0 if C is None else C.shape[1])
         result = train_vae(
             Xn[~mask], None if C is None else C[~mask], config,
             val_features=Xn[mask] if mask.any() else None,
             val_conditions=None if C is None or not mask.any() else C[mask],
+            model=net,
         )
         self.network_ = result.model
         self.history_ = result.history

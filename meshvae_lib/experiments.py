@@ -290,50 +290,12 @@ def _stable_vae_class(sigmoid_output: bool = False, noise_scale=None):
 
 
 def _fit(model, collection, noise_scale=None):
-    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class`` (same steps otherwise).
+    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class``.
 
     ``noise_scale``: train with the paper's sigma_object prior (see ``_stable_vae_class``); the
     config's own ``sigma_object`` must then be None.
     """
-    import torch
-
-    from meshvae_lib.features import ConditionEncoder, FeatureExtractor
-    from meshvae_lib.normalization import FeatureNormalizer
-    from meshvae_lib.training import holdout_mask, pad_sigma_object, train_vae
-
-    config = model.config
-    V = np.asarray(collection.vertices, dtype=np.float64)
-    labels = dict(getattr(collection, "labels", {}) or {})
-    mask = holdout_mask(len(V), model.holdout_every)
-    if mask[model.reference_index]:
-        raise ValueError(f"the reference mesh {model.reference_index} would be held out")
-    model.extractor_ = FeatureExtractor(model.features, model.layout, model.reference_index)
-    model.extractor_.fit(V, collection.faces)
-    X = model.extractor_.transform(V)
-    model.normalizer_ = FeatureNormalizer().fit(X[~mask])
-    Xn = model.normalizer_.transform(X)
-    missing = [c for c in model.labels if c not in labels]
-    if missing:
-        raise ValueError(f"no label column(s) {missing}; the data has {sorted(labels)}")
-    model.conditions_ = ConditionEncoder(model.labels).fit({c: np.asarray(labels[c])[~mask] for c in model.labels})
-    C = model.conditions_.transform(labels) if model.labels else None
-    n_cond = 0 if C is None else C.shape[1]
-    with torch.random.fork_rng(devices=[]):
-        torch.manual_seed(config.seed)
-        net = _stable_vae_class(noise_scale=noise_scale)(Xn.shape[1], config.latent_dim, config.hidden, n_cond)
-    result = train_vae(
-        Xn[~mask], None if C is None else C[~mask], config,
-        val_features=Xn[mask] if mask.any() else None,
-        val_conditions=None if C is None or not mask.any() else C[mask],
-        model=net,
-    )
-    model.network_ = result.model
-    model.history_ = result.history
-    model.train_seconds_ = result.seconds
-    model.holdout_mask_ = mask
-    model.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
-    so = pad_sigma_object(config.sigma_object, model.network_.latent_dim)
-    model.sigma_object_ = np.ones(model.network_.latent_dim) if so is None else so
+    model.fit(collection, network=_stable_vae_class(noise_scale=noise_scale))
     model.noise_scale_ = None if noise_scale is None else np.asarray(noise_scale, dtype=np.float64)
     return model
 
