@@ -482,6 +482,21 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
 # --------------------------------------------------------------------------------------------
 
 
+def _density_resolutions(base: int) -> tuple[int, int, int]:
+    """The base resolution and two others for the density rows: 0.8x and 1.25x the base when
+    ``data_synth`` can make them (the paper's 6002 / 6890 / 8002 points), else the nearest
+    factors inside its [MIN_RESOLUTION, MAX_RESOLUTION] (for the quick preset's 300: 375, 480)."""
+    from data_synth.constants import MAX_RESOLUTION, MIN_RESOLUTION
+
+    base = int(base)
+    ok = [int(round(f * base)) for f in (0.8, 1.25, 1.6, 0.64)]
+    ok = [r for r in ok if MIN_RESOLUTION <= r <= MAX_RESOLUTION and r != base]
+    if len(ok) < 2:
+        raise ValueError(f"cannot pick two other densities around resolution {base} inside "
+                         f"[{MIN_RESOLUTION}, {MAX_RESOLUTION}]; pass resolutions= explicitly")
+    return (base, ok[0], ok[1])
+
+
 @_timed
 def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolutions=None,
                      settings: ExperimentSettings | None = None, quick: bool = False,
@@ -496,7 +511,7 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     s = _settings(settings, quick)
     base_res = s.resolution or 600
     if resolutions is None:
-        resolutions = (base_res, int(round(0.8 * base_res)), int(round(1.25 * base_res)))
+        resolutions = _density_resolutions(base_res)
     resolutions = [int(r) for r in resolutions]
     cols = ["base mesh", "points (asked)", "points", "error", "relative error", "paper base", "paper points",
             "paper error"]

@@ -133,6 +133,17 @@ def test_robustness_table_reference_and_density(cache):
     assert t.rows[0][5] == "No. 1" and t.rows[0][7] == pytest.approx(2.77e-4)
 
 
+def test_density_resolutions_stay_inside_data_synth_limits():
+    from data_synth.constants import MAX_RESOLUTION, MIN_RESOLUTION
+
+    assert exps._density_resolutions(400) == (400, 320, 500)  # the paper's 0.8x / 1.25x
+    quick = exps._density_resolutions(exps.ExperimentSettings.quick().resolution)
+    assert quick[0] == 300 and len(set(quick)) == 3
+    assert all(MIN_RESOLUTION <= r <= MAX_RESOLUTION for r in quick)
+    top = exps._density_resolutions(MAX_RESOLUTION)
+    assert all(r <= MAX_RESOLUTION for r in top) and len(set(top)) == 3
+
+
 def test_loss_table(coll, cache):
     t = exps.loss_table(coll, epoch_factor=2, settings=SETTINGS, cache=cache)
     assert len(t.rows) == 2
