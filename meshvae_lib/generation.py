@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["sample_prior", "nearest_neighbors", "rimd_feature_rows", "generate", "GenerationResult"]
+__all__ = ["sample_prior", "nearest_neighbors", "rimd_feature_rows", "dataset_feature_rows", "generate",
+           "GenerationResult"]
 
 
 def sample_prior(n: int, latent_dim: int, sigma_object=None, seed: int = 0) -> np.ndarray:
@@ -148,8 +149,40 @@ class GenerationResult:
         return "\n".join(lines)
 
 
+def _check_feature_space(feature_space: str) -> None:
+    if feature_space not in ("rimd", "model"):
+        raise ValueError(f"feature_space must be 'rimd' or 'model', got {feature_space!r}")
+
+
+def _feature_rows(model, V: np.ndarray, feature_space: str) -> np.ndarray:
+    if feature_space == "rimd":
+        return rimd_feature_rows(model.extractor_.reference_, V, model.extractor_.faces_)
+    return np.asarray(model.extractor_.transform(V), dtype=np.float64).reshape(len(V), -1)
+
+
+def dataset_feature_rows(model, dataset, feature_space: str = "rimd") -> np.ndarray:
+    """The feature rows ``generate`` compares against, computed once for repeated calls.
+
+    Parameters
+    ----------
+    model : a trained ``checkpoint.MeshVAEModel``
+    dataset : a collection (``vertices (M, n_vertices, 3)``) or its vertices
+    feature_space : "rimd" or "model", as in :func:`generate`
+
+    Returns
+    -------
+    X : (M, K) float64, to pass to ``generate(..., dataset_features=X)``
+    """
+    _check_feature_space(feature_space)
+    D = np.asarray(getattr(dataset, "vertices", dataset), dtype=np.float64)
+    if D.ndim != 3 or D.shape[-1] != 3:
+        raise ValueError(f"dataset must be (M, n_vertices, 3) meshes, got {D.shape}")
+    return _feature_rows(model, D, feature_space)
+
+
 def generate(
-    model, n: int, seed: int = 0, condition: dict | None = None, dataset=None, feature_space: str = "rimd"
+    model, n: int, seed: int = 0, condition: dict | None = None, dataset=None, feature_space: str = "rimd",
+    dataset_features=None,
 ) -> GenerationResult:
     """Generate ``n`` meshes from the prior and find their nearest training meshes (Sec. 5.2).
 
@@ -165,6 +198,8 @@ def generate(
     feature_space : "rimd" (the paper's: RIMD features relative to the model's reference mesh,
         whatever features the model itself uses) or "model" (the model's own, unnormalised
         feature rows, e.g. aligned coordinates)
+    dataset_features : (M, K) float64 or None, the dataset's rows from
+        :func:`dataset_feature_rows` (same ``feature_space``); saves recomputing them on every call
 
     Returns
     -------
@@ -172,8 +207,7 @@ def generate(
     """
     if int(n) < 1:
         raise ValueError(f"n must be >= 1, got {n}")
-    if feature_space not in ("rimd", "model"):
-        raise ValueError(f"feature_space must be 'rimd' or 'model', got {feature_space!r}")
+    _check_feature_space(feature_space)
     z = model.sample_latent(int(n), seed=seed)
     cond = None
     if model.is_conditional:
@@ -190,13 +224,14 @@ def generate(
     D = np.asarray(getattr(dataset, "vertices", dataset), dtype=np.float64)
     if D.ndim != 3 or D.shape[1:] != V.shape[1:]:
         raise ValueError(f"dataset must be (M, {V.shape[1]}, 3) meshes, got {D.shape}")
-    if feature_space == "rimd":
-        ref, F = model.extractor_.reference_, model.extractor_.faces_
-        Xd = rimd_feature_rows(ref, D, F)
-        Xg = rimd_feature_rows(ref, V, F)
+    Xg = _feature_rows(model, V, feature_space)
+    if dataset_features is None:
+        Xd = _feature_rows(model, D, feature_space)
     else:
-        Xd = model.extractor_.transform(D)
-        Xg = model.extractor_.transform(V)
+        Xd = np.asarray(dataset_features, dtype=np.float64)
+        if Xd.shape != (len(D), Xg.shape[1]):
+            raise ValueError(f"dataset_features must be ({len(D)}, {Xg.shape[1]}) for this dataset and "
+                             f"feature_space={feature_space!r}, got {Xd.shape}")
     result.nearest, result.distance = nearest_neighbors(Xg, Xd)
     if len(D) >= 2:
         result.dataset_nn_distance = nearest_neighbors(Xd, Xd, exclude_self=True)[1]

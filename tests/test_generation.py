@@ -101,6 +101,21 @@ def test_generate_shapes_determinism_and_neighbours():
         gen.generate(model, 2, dataset=coll, feature_space="xyz")
 
 
+@pytest.mark.parametrize("space", ["rimd", "model"])
+def test_generate_with_precomputed_dataset_features_matches(space):
+    coll = _tiny_collection()
+    model = _tiny_model(coll)
+    X = gen.dataset_feature_rows(model, coll, feature_space=space)
+    assert X.shape[0] == 12 and X.dtype == np.float64
+    a = gen.generate(model, 5, seed=3, dataset=coll, feature_space=space)
+    b = gen.generate(model, 5, seed=3, dataset=coll, feature_space=space, dataset_features=X)
+    np.testing.assert_array_equal(a.nearest, b.nearest)
+    np.testing.assert_array_equal(a.distance, b.distance)
+    np.testing.assert_array_equal(a.dataset_nn_distance, b.dataset_nn_distance)
+    with pytest.raises(ValueError, match=r"dataset_features must be \(12, "):
+        gen.generate(model, 2, dataset=coll, feature_space=space, dataset_features=X[:5])
+
+
 def test_generate_conditional_uses_the_condition():
     coll = _tiny_collection()
     model = _tiny_model(coll, labels=("shape",))
