@@ -94,7 +94,9 @@ class MeshVAEModel:
     conditions_ : ConditionEncoder (columns, categories).
     train_conditions_ : (N_train, C) float32, the training meshes' condition vectors (to sample
         values of columns a user leaves unset).
-    sigma_object_ : (D,) float64 prior deviations (ones for the standard prior).
+    sigma_object_ : (D,) float64 deviations of the latent prior that :meth:`sample_latent` draws
+        from: the config's sigma_object with the exact prior form, ones for the standard prior and
+        for the sibling form (whose latent cost keeps the means' unit spread).
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.training.TrainResult`).
     train_seconds_ : float.
@@ -157,7 +159,8 @@ class MeshVAEModel:
         self.holdout_mask_ = mask
         self.train_conditions_ = (np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask])
         so = pad_sigma_object(config.sigma_object, self.network_.latent_dim)
-        self.sigma_object_ = np.ones(self.network_.latent_dim) if so is None else so
+        exact = so is not None and config.prior_form == "exact"
+        self.sigma_object_ = so if exact else np.ones(self.network_.latent_dim)
         self.config = config
         return self
 

@@ -19,7 +19,7 @@ import numpy as np
 import torch
 
 from .tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, HIDDEN_COORDS
-from .vae import MeshVAE, start_step, vae_loss
+from .vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
 
 __all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object"]
 
@@ -52,6 +52,9 @@ class TrainConfig:
     hidden : internal layer sizes, outermost first (default: none).
     sigma_object : prior deviations (length D) or None for N(0, I) (Sec. 4.4). Shorter vectors are
         padded with 1 by :func:`pad_sigma_object`.
+    prior_form : how sigma_object enters the latent cost, "exact" (the KL to N(0, diag
+        sigma_object^2)) or "sibling" (the authors' sibling-code formula, which makes the chosen
+        dimensions carry the dominant variation; see :func:`~meshvae_lib.vae.kl_divergence`).
     seed : seeds initial weights, shuffling and sampling.
     device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
     progress : show a tqdm progress bar (terminal or notebook).
@@ -65,6 +68,7 @@ class TrainConfig:
     latent_dim: int = DEFAULT_LATENT
     hidden: tuple[int, ...] = ()
     sigma_object: tuple[float, ...] | None = None
+    prior_form: str = "exact"
     seed: int = 0
     device: str = "auto"
     progress: bool = True
@@ -81,6 +85,7 @@ class TrainConfig:
             "alpha": self.alpha > 0,
             "latent_dim": self.latent_dim >= 1,
             "eval_every": self.eval_every >= 1,
+            "prior_form": self.prior_form in PRIOR_FORMS,
         }
         for name, ok in checks.items():
             if not ok:
@@ -160,10 +165,10 @@ def _batches(n: int, batch_size: int, perm: torch.Tensor) -> list[torch.Tensor]:
 
 
 @torch.no_grad()
-def _evaluate(model, x, c, alpha, sigma_object) -> dict:
+def _evaluate(model, x, c, alpha, sigma_object, prior_form) -> dict:
     model.eval()
     mu, sigma = model.encode(x, c)
-    parts = vae_loss(model.decode(mu, c), x, mu, sigma, alpha, sigma_object)
+    parts = vae_loss(model.decode(mu, c), x, mu, sigma, alpha, sigma_object, prior_form)
     return {f"val_{k}": float(v) for k, v in parts.items()}
 
 
@@ -240,7 +245,7 @@ def train_vae(
             xb = x[idx]
             cb = None if c is None else c[idx]
             x_hat, mu, sigma = model(xb, cb, generator=noise_gen)
-            parts = vae_loss(x_hat, xb, mu, sigma, config.alpha, so_t)
+            parts = vae_loss(x_hat, xb, mu, sigma, config.alpha, so_t, config.prior_form)
             start_step(model)  # zero the gradients, keeping the big buffers (see vae.Linear)
             parts["total"].backward()
             optimizer.step()
@@ -254,7 +259,7 @@ def train_vae(
         record = {"epoch": epoch + 1, **sums}
         last = epoch + 1 == config.epochs
         if xv is not None and ((epoch + 1) % config.eval_every == 0 or last):
-            record.update(_evaluate(model, xv, cv, config.alpha, so_t))
+            record.update(_evaluate(model, xv, cv, config.alpha, so_t, config.prior_form))
         history.append(record)
         logger.debug("epoch %d: %s", epoch + 1, record)
         if config.progress:

@@ -10,7 +10,8 @@ decoder one linear map D -> K, so there are no internal layers.
 Conditional mesh VAE (Sec. 4.3, Eq. 5): a condition vector c (one-hot labels or any given vector)
 is concatenated to the encoder's input and to the decoder's input.
 
-Extended model (Sec. 4.4): the prior is N(0, diag(sigma_object^2)).
+Extended model (Sec. 4.4): the prior is N(0, diag(sigma_object^2)); ``kl_divergence`` has the
+exact KL to it and the authors' sibling-code formula (``form="sibling"``).
 
 Loss (Eq. 4), for a batch of M meshes with K features each::
 
@@ -31,7 +32,7 @@ from torch import nn
 
 from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_LOGIT_MIN, SIGMA_MAX
 
-__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear"]
+__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear", "PRIOR_FORMS"]
 
 
 class _LinearGradInPlace(torch.autograd.Function):
@@ -226,23 +227,35 @@ class MeshVAE(nn.Module):
         return self.decode(z, c), mu, sigma
 
 
-def kl_divergence(
-    mu: torch.Tensor, sigma: torch.Tensor, sigma_object: torch.Tensor | None = None
-) -> torch.Tensor:
-    """KL( N(mu, diag sigma^2) || N(0, diag sigma_object^2) ), summed over the latent dimensions.
+PRIOR_FORMS = ("exact", "sibling")
 
-    Exact closed form, per dimension::
+
+def kl_divergence(
+    mu: torch.Tensor, sigma: torch.Tensor, sigma_object: torch.Tensor | None = None, form: str = "exact"
+) -> torch.Tensor:
+    """The latent cost of Eq. (4) with the extended prior of Sec. 4.4, summed over the dimensions.
+
+    ``form="exact"``: KL( N(mu, diag sigma^2) || N(0, diag sigma_object^2) ), per dimension::
 
         1/2 [ (sigma^2 + mu^2) / sigma_object^2 - 1 - log(sigma^2 / sigma_object^2) ]
 
-    With ``sigma_object=None`` the prior is N(0, I) (paper Eq. 4). The authors' sibling code
-    writes ``1/2 [mu^2 + (sigma/sigma_object)^2 - log((sigma/sigma_object)^2) - 1]``, which does not
-    divide mu^2 by sigma_object^2: it shrinks the posterior's width in the chosen dimensions but
-    not the spread of their means. Here the exact KL is used (Sec. 4.4).
+    ``form="sibling"``: the formula of the authors' sibling code, per dimension::
 
-    mu, sigma : (B, D) float tensors, sigma > 0; sigma_object : (D,) positive or None.
-    Returns (B,) KL per sample.
+        1/2 [ mu^2 + (sigma / sigma_object)^2 - log((sigma / sigma_object)^2) - 1 ]
+
+    which does not divide mu^2 by sigma_object^2. It is not a KL to a fixed prior: it makes a
+    *narrow* posterior (width about sigma_object) cheap in the chosen dimensions while the means
+    keep the unit spread of N(0, I). The exact form is invariant under ``z_i -> z_i / s_i`` (a
+    linear decoder absorbs the rescaling), so on its own it cannot make a dimension more important;
+    the sibling form can (see ``docs/applications.md``, "Embedding"). With ``sigma_object=None``
+    both forms are the standard KL to N(0, I) (paper Eq. 4).
+
+    mu, sigma : (B, D) float tensors, sigma > 0; sigma_object : (D,) positive or None;
+    form : "exact" or "sibling".
+    Returns (B,) latent cost per sample.
     """
+    if form not in PRIOR_FORMS:
+        raise ValueError(f"form must be one of {PRIOR_FORMS}, got {form!r}")
     if mu.shape != sigma.shape:
         raise ValueError(f"mu and sigma must have the same shape, got {tuple(mu.shape)} and {tuple(sigma.shape)}")
     var = sigma * sigma
@@ -252,6 +265,8 @@ def kl_divergence(
     if so.shape != mu.shape[-1:]:
         raise ValueError(f"sigma_object must have shape ({mu.shape[-1]},), got {tuple(so.shape)}")
     var_o = so * so
+    if form == "sibling":
+        return 0.5 * torch.sum(mu * mu + var / var_o - 1.0 - torch.log(var / var_o), dim=-1)
     return 0.5 * torch.sum((var + mu * mu) / var_o - 1.0 - torch.log(var / var_o), dim=-1)
 
 
@@ -262,10 +277,12 @@ def vae_loss(
     sigma: torch.Tensor,
     alpha: float = DEFAULT_ALPHA,
     sigma_object: torch.Tensor | None = None,
+    prior_form: str = "exact",
 ) -> dict[str, torch.Tensor]:
     """Mesh VAE loss (Eq. 4; Eq. 5 for the conditional model, whose prior does not depend on c).
 
-    x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D).
+    x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D); sigma_object and
+    prior_form : see :func:`kl_divergence`.
     Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2,
     ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise), and ``mse`` =
     mean squared error per component (for logging; alpha-free).
@@ -274,5 +291,5 @@ def vae_loss(
         raise ValueError(f"x_hat and x must be (M, K) of the same shape, got {tuple(x_hat.shape)} and {tuple(x.shape)}")
     mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
     reconstruction = 0.5 * alpha * mse
-    kl = torch.mean(kl_divergence(mu, sigma, sigma_object))
+    kl = torch.mean(kl_divergence(mu, sigma, sigma_object, prior_form))
     return {"total": reconstruction + kl, "reconstruction": reconstruction, "kl": kl, "mse": mse.detach()}

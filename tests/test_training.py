@@ -64,6 +64,40 @@ def test_sigma_object_shrinks_the_spread_of_the_chosen_dimensions():
     assert np.all(small[2:] > 0.5), small
 
 
+def test_sibling_prior_form_puts_the_dominant_variation_in_the_chosen_dimensions():
+    """The reason the embedding and exploration models use prior_form="sibling" (Sec. 4.4).
+
+    Decode the encoder means with only one pair of latent dimensions kept (the rest zeroed): the
+    lower the error, the more of the data that pair carries. With the sibling formula dimensions
+    1-2 carry the most; with the exact KL they end up unused (the KL blind to rescaling gives them
+    no advantage, and their 100x width cost at the start of training switches them off).
+    """
+    X = _data(n=40, k=40, seed=1)
+    x = torch.from_numpy(X.astype(np.float32))
+
+    def pair_errors(form):
+        res = train_vae(X, config=TrainConfig(epochs=100, batch_size=8, alpha=200.0, latent_dim=6, lr=1e-2,
+                                              sigma_object=(0.1, 0.1), prior_form=form, progress=False, seed=0))
+        with torch.no_grad():
+            mu, sigma = res.model.encode(x)
+
+            def keep(dims):
+                z = torch.zeros_like(mu)
+                z[:, dims] = mu[:, dims]
+                return float(((res.model.decode(z) - x) ** 2).mean())
+
+            return [keep([0, 1]), keep([2, 3]), keep([4, 5]), keep([])], mu.std(0).numpy(), sigma.mean(0).numpy()
+
+    (p12, p34, p56, none), spread, width = pair_errors("sibling")
+    assert p12 < 0.6 * min(p34, p56) and p12 < 0.4 * none, (p12, p34, p56, none)
+    assert np.all(spread[:2] > 0.5) and np.all(width[:2] < 0.2), (spread, width)  # unit-spread means, narrow posteriors
+    (p12, p34, p56, none), spread, _ = pair_errors("exact")
+    assert p12 > 0.95 * none and min(p34, p56) < 0.8 * none, (p12, p34, p56, none)
+    assert np.all(spread[:2] < 0.05), spread
+    with pytest.raises(ValueError, match="prior_form"):
+        TrainConfig(prior_form="paper")
+
+
 def test_holdout_mask_and_sigma_object_padding():
     np.testing.assert_array_equal(np.flatnonzero(holdout_mask(10, 3)), [2, 5, 8])
     assert not holdout_mask(5, 0).any()

@@ -83,6 +83,42 @@ def test_kl_matches_monte_carlo_estimate():
     assert abs(sibling - exact) > 20 * stderr
 
 
+def test_sibling_form_hand_computed_and_its_minimiser():
+    mu = torch.tensor([[0.5, -2.0]], dtype=torch.float64)
+    sigma = torch.tensor([[0.05, 1.0]], dtype=torch.float64)
+    so = torch.tensor([0.1, 1.0], dtype=torch.float64)
+    # by hand: dim 1: 1/2 [0.25 + 0.25 - ln 0.25 - 1] = 0.4431472; dim 2: 1/2 [4 + 1 - 0 - 1] = 2
+    expected = 0.5 * (0.25 + 0.25 - math.log(0.25) - 1) + 2.0
+    assert float(kl_divergence(mu, sigma, so, form="sibling")[0]) == pytest.approx(expected, rel=1e-12)
+    # without sigma_object both forms are the standard KL
+    torch.testing.assert_close(kl_divergence(mu, sigma, form="sibling"), kl_divergence(mu, sigma))
+    # minimised over sigma at sigma = sigma_object, over mu at mu = 0 (unit price on the means)
+    s = torch.linspace(0.02, 0.5, 481, dtype=torch.float64)[:, None]
+    cost = kl_divergence(torch.zeros_like(s), s, so[:1], form="sibling")
+    assert float(s[torch.argmin(cost), 0]) == pytest.approx(0.1, abs=1e-3)
+    m = torch.linspace(-1, 1, 201, dtype=torch.float64)[:, None]
+    cost = kl_divergence(m, torch.full_like(m, 0.1), so[:1], form="sibling")
+    assert abs(float(m[torch.argmin(cost), 0])) < 1e-12
+    # a mean offset costs mu^2 / 2, as in a unit-prior dimension (the exact KL charges mu^2 / (2 s^2))
+    assert float(cost[-1] - cost[100]) == pytest.approx(0.5, rel=1e-12)
+    with pytest.raises(ValueError, match="form must be one of"):
+        kl_divergence(mu, sigma, so, form="paper")
+
+
+def test_exact_form_is_invariant_under_latent_rescaling_and_sibling_is_not():
+    """z_i -> z_i / s_i maps (mu, sigma) to (mu/s, sigma/s): the exact KL to N(0, diag s^2) equals the
+    standard KL of the rescaled posterior, so a linear decoder can undo sigma_object; the sibling
+    formula charges the means at unit price and so tells the two apart."""
+    g = torch.Generator().manual_seed(11)
+    mu = torch.randn(5, 4, generator=g, dtype=torch.float64)
+    sigma = torch.rand(5, 4, generator=g, dtype=torch.float64) + 0.05
+    so = torch.tensor([0.1, 0.1, 1.0, 1.0], dtype=torch.float64)
+    exact = kl_divergence(mu * so, sigma * so, so)
+    torch.testing.assert_close(exact, kl_divergence(mu, sigma), rtol=1e-12, atol=1e-12)
+    sibling = kl_divergence(mu * so, sigma * so, so, form="sibling")
+    assert float((sibling - kl_divergence(mu, sigma)).abs().min()) > 1e-3
+
+
 def test_loss_terms_follow_equation_4():
     g = torch.Generator().manual_seed(0)
     x = torch.rand(4, 10, generator=g)

@@ -60,6 +60,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="label columns to condition on (conditional mesh VAE, Eq. 5)")
     p.add_argument("--sigma-object", type=_floats, default=None, metavar="V1,V2,...",
                    help="prior deviations of the first latent dimensions (Sec. 4.4); the rest are 1")
+    p.add_argument("--prior-form", choices=("exact", "sibling"), default="exact",
+                   help="how --sigma-object enters the latent cost: the exact KL (default) or the authors'"
+                        " sibling-code formula, which makes the small-sigma dimensions carry the dominant"
+                        " variation (for 2D maps and exploration)")
     p.add_argument("--reference", type=int, default=0, metavar="I", help="index of the reference mesh (default 0)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
     p.add_argument("--device", default="auto", help="auto (GPU when available), cpu, cuda, ... (default auto)")
@@ -83,7 +87,8 @@ def run(args) -> int:
     epochs = args.epochs if args.epochs is not None else d.epochs
     hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features)
     config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
-                         latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object, seed=args.seed,
+                         latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
+                         prior_form=args.prior_form, seed=args.seed,
                          device=args.device, progress=not args.no_progress)
     print(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
           f" latent {args.latent}, hidden {list(hidden)}, {epochs} epochs")
