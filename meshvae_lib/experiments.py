@@ -25,6 +25,7 @@ and of its reconstruction (encoder mean, decoder, mesh), after rigid alignment, 
 from __future__ import annotations
 
 import logging
+import textwrap
 import time
 from dataclasses import dataclass, field
 from typing import Sequence
@@ -91,6 +92,8 @@ class ExperimentSettings:
     layout : RIMD layout; "compact" stores each edge's rotation once (the paper's layout stores
         both directions, ``log dR_ji = -log dR_ij``: the same information, twice the columns)
     seed : seeds data, initial weights, shuffling and sampling
+    embedding_steps : Adam steps of the embedding models (Sec. 5.4), which need longer training
+        than the error tables for the latent cost to shape the map
     """
 
     resolution: int | None = 400
@@ -103,11 +106,12 @@ class ExperimentSettings:
     holdout_every: int = 5
     layout: str = "compact"
     seed: int = 0
+    embedding_steps: int = 1000
 
     @classmethod
     def quick(cls, **kw) -> "ExperimentSettings":
         """A tiny preset: minimal meshes, at most 40 of them, 60 steps (seconds per model)."""
-        base = dict(resolution=300, max_meshes=40, train_steps=60, min_epochs=5, latent_dim=16)
+        base = dict(resolution=300, max_meshes=40, train_steps=60, min_epochs=5, latent_dim=16, embedding_steps=60)
         base.update(kw)
         return cls(**base)
 
@@ -245,24 +249,15 @@ def load_collection(entry, settings: ExperimentSettings | None = None, resolutio
     return data
 
 
-def _stable_vae_class(sigmoid_output: bool = False, noise_scale=None):
+def _stable_vae_class(sigmoid_output: bool = False):
     """MeshVAE with ``sigma = sigma_max * sigmoid(s) + SIGMA_FLOOR`` (optionally a sigmoid output).
 
     With the paper's alpha = 1e6 the reconstruction term drives the posterior deviation towards 0;
-    after a few hundred Adam steps ``sigma_max * sigmoid(s)`` underflows in float32, the KL term's
-    ``log(sigma^2)`` becomes -inf and training turns to NaN (measured: epoch 78 of 300 on a
-    160-mesh body collection). A floor of ``tolerances.SIGMA_FLOOR`` keeps every term finite and
-    changes nothing measurable otherwise.
-
-    ``noise_scale`` (D,) gives the *paper's* sigma_object prior (Sec. 4.4, as the authors' sibling
-    code writes it, see ``docs/applications.md``): the encoder reports ``sigma' = sigma /
-    sigma_object`` to the standard KL, and the sample is ``z = mu + sigma_object * sigma' * eps``.
-    Then the standard KL of ``(mu, sigma')`` is exactly
-    ``1/2 [mu^2 + (sigma/sigma_object)^2 - log (sigma/sigma_object)^2 - 1]``: small sigma_object
-    makes a dimension's posterior narrow (a precise, cheap channel for the dominant variation)
-    while its means keep the unit spread the paper browses in [-2, 2]. (The exact KL to
-    N(0, diag sigma_object^2) is invariant under z_i -> z_i / sigma_object_i, which the linear
-    decoder absorbs, so on its own it does not single out the chosen dimensions.)
+    after a few hundred Adam steps ``sigma_max * sigmoid(s)`` underflowed in float32, the KL term's
+    ``log(sigma^2)`` became -inf and training turned to NaN (measured: epoch 78 of 300 on a
+    160-mesh body collection). ``MeshVAE`` now floors the sigmoid's input (``SIGMA_LOGIT_MIN``);
+    the floor of ``tolerances.SIGMA_FLOOR`` here is kept so that the tables stay comparable with
+    earlier runs, and changes nothing measurable otherwise.
     """
     import torch
 
@@ -272,12 +267,6 @@ def _stable_vae_class(sigmoid_output: bool = False, noise_scale=None):
         def encode(self, x, c=None):
             mu, sigma = super().encode(x, c)
             return mu, sigma + tol.SIGMA_FLOOR
-
-        if noise_scale is not None:
-
-            def reparameterize(self, mu, sigma, generator=None):
-                scale = torch.as_tensor(np.asarray(noise_scale), dtype=mu.dtype, device=mu.device)
-                return super().reparameterize(mu, sigma * scale, generator)
 
         if sigmoid_output:
 
@@ -289,52 +278,41 @@ def _stable_vae_class(sigmoid_output: bool = False, noise_scale=None):
     return StableMeshVAE
 
 
-def _fit(model, collection, noise_scale=None):
-    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class``.
-
-    ``noise_scale``: train with the paper's sigma_object prior (see ``_stable_vae_class``); the
-    config's own ``sigma_object`` must then be None.
-    """
-    model.fit(collection, network=_stable_vae_class(noise_scale=noise_scale))
-    model.noise_scale_ = None if noise_scale is None else np.asarray(noise_scale, dtype=np.float64)
-    return model
+def _fit(model, collection):
+    """``MeshVAEModel.fit`` with the network of ``_stable_vae_class``."""
+    return model.fit(collection, network=_stable_vae_class())
 
 
 def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_extra=(), *, features="rimd",
            latent_dim=None, sigma_object=None, labels=(), reference_index=0, holdout=True, epochs=None,
-           prior: str = "paper"):
+           prior: str = "sibling", hidden=None, alpha=None, seed=None):
     """A trained MeshVAEModel (from the cache when the same model was trained already).
 
-    ``prior`` (only with ``sigma_object``): "paper" -- the authors' form of the sigma_object KL
-    (posterior widths shrink, means keep unit spread; see ``_stable_vae_class``), or "exact" --
-    the library's exact KL to N(0, diag sigma_object^2) (``vae.kl_divergence``).
+    ``prior`` (only with ``sigma_object``): "sibling" -- the authors' sibling-code formula (posterior
+    widths shrink, means keep unit spread), or "exact" -- the exact KL to N(0, diag sigma_object^2);
+    see ``vae.kl_divergence``. ``hidden``, ``alpha``, ``seed``: override the defaults (the feature
+    kind's ``default_hidden``, the paper's alpha = 1e6, the settings' seed).
     """
-    if prior not in ("paper", "exact"):
-        raise ValueError(f"prior must be 'paper' or 'exact', got {prior!r}")
     from meshvae_lib.checkpoint import MeshVAEModel
     from meshvae_lib.training import TrainConfig, default_hidden, holdout_mask
 
-    hidden = default_hidden(features)  # the baselines get the layer that did best for them (Table 3)
+    hidden = default_hidden(features) if hidden is None else tuple(int(h) for h in hidden)
+    alpha = tol.DEFAULT_ALPHA if alpha is None else float(alpha)
+    seed = settings.seed if seed is None else int(seed)
     latent = settings.latent_dim if latent_dim is None else int(latent_dim)
     every = settings.holdout_every if holdout else 0
     n_train = int((~holdout_mask(len(coll.vertices), every)).sum())
     ep = settings.epochs_for(n_train) if epochs is None else int(epochs)
     so = None if sigma_object is None else tuple(float(s) for s in sigma_object)
     key = ("model", key_extra, id(coll), features, latent, so, tuple(labels), reference_index, every, ep,
-           settings.layout, settings.seed, settings.batch_size, hidden, prior if so else None)
+           settings.layout, seed, settings.batch_size, hidden, alpha, prior if so else None)
     if cache is not None and key in cache:
         return cache[key]
-    paper_prior = so is not None and prior == "paper"
-    cfg = TrainConfig(epochs=ep, batch_size=settings.batch_size, latent_dim=latent, hidden=hidden,
-                      sigma_object=None if paper_prior else so, seed=settings.seed, device="cpu", progress=False)
+    cfg = TrainConfig(epochs=ep, batch_size=settings.batch_size, latent_dim=latent, hidden=hidden, alpha=alpha,
+                      sigma_object=so, prior_form=prior, seed=seed, device="cpu", progress=False)
     model = MeshVAEModel(features=features, config=cfg, labels=labels, holdout_every=every,
                          layout=settings.layout, reference_index=reference_index)
-    noise = None
-    if paper_prior:
-        from meshvae_lib.training import pad_sigma_object
-
-        noise = pad_sigma_object(so, latent)
-    model = _fit(model, coll, noise_scale=noise)
+    model = _fit(model, coll)
     if cache is not None:
         cache[key] = model
     return model
@@ -639,14 +617,22 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
 
 @_timed
 def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"), relevance: str = "each",
-                    compare_exact: bool = True, settings: ExperimentSettings | None = None, quick: bool = False,
+                    compare_exact: bool = True, compare_paper_defaults: bool = True,
+                    seeds=tol.EMBEDDING_SEEDS, alpha: float = tol.EMBEDDING_ALPHA, hidden=tol.EMBEDDING_HIDDEN,
+                    settings: ExperimentSettings | None = None, quick: bool = False,
                     cache: dict | None = None) -> ExperimentTable:
     """Sec. 5.4: 2D embeddings and their retrieval precision-recall AUC.
 
-    The sigma_object VAE (deviations 0.1 for the first two latent dimensions, 1 for the rest) is
-    trained on the whole collection; its embedding is the first two encoder means. PCA, NPE
-    (k = 25) and t-SNE (perplexity 30) embed the same normalised RIMD feature rows the VAE sees.
-    Relevance: see :mod:`meshvae_lib.embedding` ("each": per label column, averaged).
+    The sigma_object VAE (deviations 0.1 for the first two latent dimensions, 1 for the rest, the
+    sibling-code form of the latent cost) is trained on the whole collection with reconstruction
+    weight ``alpha`` and internal layers ``hidden``, once per seed; its embedding is the first two
+    encoder means and its row is the seed with the median AUC (all seeds' AUCs are in the notes and
+    in ``data["seed_aucs"]``). PCA, NPE (k = 25) and t-SNE (perplexity 30) embed the same
+    normalised RIMD feature rows the VAE sees. Relevance: see :mod:`meshvae_lib.embedding`
+    ("each": per label column, averaged).
+
+    Extra rows: ``compare_exact`` -- the same model with the exact KL; ``compare_paper_defaults`` --
+    the sibling form with the paper's general settings (alpha = 1e6, no internal layer).
     """
     from meshvae_lib import embedding as emb
 
@@ -655,41 +641,66 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     labels = {c: coll.labels[c] for c in label_columns if c in coll.labels}
     if not labels:
         raise ValueError(f"collection {_name_of(collection)!r} has none of the label columns {label_columns};"
-                         f" it has {sorted(coll.labels)}")
+                         f" it has {sorted(labels) or sorted(coll.labels)}")
+    seeds = [int(x) for x in seeds]
+    if not seeds:
+        raise ValueError("give at least one seed")
     D = s.latent_dim
-    model = _train(coll, s, cache, sigma_object=emb.embedding_sigma_object(D), holdout=False, prior="paper")
-    X = model.features_of(coll.vertices)
+    so = emb.embedding_sigma_object(D)
+    ep = max(s.min_epochs, int(np.ceil(s.embedding_steps * s.batch_size / len(coll.vertices))))
+
+    def vae_rows(prior, a, h):
+        """{seed: (embedding, PR result)} for one configuration, and the median seed."""
+        out = {}
+        for sd in seeds:
+            m = _train(coll, s, cache, ("embedding",), sigma_object=so, holdout=False, prior=prior, alpha=a,
+                       hidden=h, seed=sd, epochs=ep)
+            y = m.encode_meshes(coll.vertices)[:, :2]
+            out[sd] = (y, emb.precision_recall_curve(y, labels, relevance=relevance))
+        order = sorted(seeds, key=lambda sd: out[sd][1].auc["mean"])
+        return out, order[(len(order) - 1) // 2]
+
+    ours, med = vae_rows("sibling", alpha, hidden)
+    X = _train(coll, s, cache, ("embedding",), sigma_object=so, holdout=False, prior="sibling", alpha=alpha,
+               hidden=hidden, seed=seeds[0], epochs=ep).features_of(coll.vertices)
     k = min(tol.NPE_N_NEIGHBORS, len(X) - 1)
     Y = {
-        "sigma_object VAE": model.encode_meshes(coll.vertices)[:, :2],
+        "sigma_object VAE": ours[med][0],
         "t-SNE": emb.tsne_embedding(X, seed=s.seed),
         "PCA": emb.pca_embedding(X, seed=s.seed),
         "NPE": emb.NeighborhoodPreservingEmbedding(2, n_neighbors=k).fit_transform(X),
     }
-    cols = ["method", "AUC (mean)"] + [f"AUC {c}" for c in labels] + ["AUC joint", "paper AUC"]
-    table = ExperimentTable("embedding_auc", f"Sec. 5.4: retrieval AUC of 2D embeddings ({_name_of(collection)})", cols)
-    curves = {}
-    for m, y in Y.items():
-        res = emb.precision_recall_curve(y, labels, relevance=relevance)
-        joint = emb.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
-        curves[m] = res
-        table.rows.append([m, res.auc["mean"]] + [res.auc[c] for c in labels] + [joint, PAPER["auc"].get(m)])
+    curves = {m: (ours[med][1] if m == "sigma_object VAE" else emb.precision_recall_curve(y, labels, relevance=relevance))
+              for m, y in Y.items()}
+    seed_aucs = {"sigma_object VAE": [ours[sd][1].auc["mean"] for sd in seeds]}
+    extra = []
     if compare_exact:
-        exact = _train(coll, s, cache, sigma_object=emb.embedding_sigma_object(D), holdout=False, prior="exact")
-        y = exact.encode_meshes(coll.vertices)[:, :2]
-        res = emb.precision_recall_curve(y, labels, relevance=relevance)
+        extra.append(("sigma_object VAE, exact KL", "exact", alpha, hidden))
+    if compare_paper_defaults:
+        extra.append(("sigma_object VAE, alpha 1e6, no hidden layer", "sibling", tol.DEFAULT_ALPHA, ()))
+    for name, prior, a, h in extra:
+        runs, m = vae_rows(prior, a, h)
+        Y[name], curves[name] = runs[m]
+        seed_aucs[name] = [runs[sd][1].auc["mean"] for sd in seeds]
+
+    cols = ["method", "AUC (mean)"] + [f"AUC {c}" for c in labels] + ["AUC joint", "seeds (min-max)", "paper AUC"]
+    table = ExperimentTable("embedding_auc", f"Sec. 5.4: retrieval AUC of 2D embeddings ({_name_of(collection)})", cols)
+    for m, y in Y.items():
+        res = curves[m]
         joint = emb.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
-        table.rows.append(["sigma_object VAE, exact KL"] + [res.auc["mean"]] + [res.auc[c] for c in labels]
-                          + [joint, None])
-        Y["sigma_object VAE, exact KL"] = y
-        curves["sigma_object VAE, exact KL"] = res
-    table.data.update(embeddings=Y, labels=labels, curves=curves)
-    ours = table.rows[0][1]
+        spread = (f"{min(seed_aucs[m]):.4f}-{max(seed_aucs[m]):.4f}" if m in seed_aucs and len(seeds) > 1 else None)
+        table.rows.append([m, res.auc["mean"]] + [res.auc[c] for c in labels] + [joint, spread, PAPER["auc"].get(m)])
+    table.data.update(embeddings=Y, labels=labels, curves=curves, seed_aucs=seed_aucs, seeds=seeds, median_seed=med,
+                      alpha=float(alpha), hidden=tuple(hidden), epochs=ep)
+    ours_auc = table.rows[0][1]
     others = {r[0]: r[1] for r in table.rows[1:4]}
-    table.data["ours_minus"] = {m: ours - a for m, a in others.items()}
+    table.data["ours_minus"] = {m: ours_auc - a for m, a in others.items()}
     table.notes.append(f"N = {len(X)} meshes; relevance = {relevance!r} (one retrieval task per label, AUCs averaged)."
-                       f" Ours minus t-SNE: {ours - others['t-SNE']:+.4f}, minus PCA: {ours - others['PCA']:+.4f},"
-                       f" minus NPE: {ours - others['NPE']:+.4f}.")
+                       f" Ours minus t-SNE: {ours_auc - others['t-SNE']:+.4f}, minus PCA: {ours_auc - others['PCA']:+.4f},"
+                       f" minus NPE: {ours_auc - others['NPE']:+.4f}.")
+    table.notes.append(f"sigma_object VAE: sibling-form latent cost, alpha = {alpha:g}, hidden layers {list(hidden)},"
+                       f" {ep} epochs; the row is the median of seeds {seeds} (AUC per seed: "
+                       + ", ".join(f"{a:.4f}" for a in seed_aucs["sigma_object VAE"]) + ").")
     return table
 
 
@@ -820,7 +831,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
     model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
-                   prior="paper")
+                   prior="sibling")
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
     regions = ex.humanoid_regions(rest)
     measure = lambda V: ex.measure_humanoid(V, regions)  # noqa: E731
@@ -921,26 +932,31 @@ def _plot_loss(table):
 
 
 def _plot_embedding(table):
-    fig = _figure(12, 6.2)
     Y = table.data["embeddings"]
     labels = table.data["labels"]
-    col = next(iter(labels))
-    lab = labels[col]
-    cats, codes = np.unique(lab, return_inverse=True)
-    for i, (m, y) in enumerate(Y.items()):
-        ax = fig.add_subplot(2, 4, i + 1)
-        ax.scatter(y[:, 0], y[:, 1], c=codes, cmap="tab10", s=6)
-        ax.set_title(m, fontsize=9)
-        ax.set_xticks([])
-        ax.set_yticks([])
-    ax = fig.add_subplot(2, 2, 3)
+    n = len(Y)
+    fig = _figure(2.3 * max(n, 4), 2.3 * len(labels) + 3.4)
+    fig.set_layout_engine("constrained")  # tight_layout cannot place the legend beside the curves
+    grid = fig.add_gridspec(len(labels) + 1, n, height_ratios=[1] * len(labels) + [1.5])
+    for r, (col, lab) in enumerate(labels.items()):
+        cats, codes = np.unique(lab, return_inverse=True)
+        for i, (m, y) in enumerate(Y.items()):
+            ax = fig.add_subplot(grid[r, i])
+            ax.scatter(y[:, 0], y[:, 1], c=codes, cmap="tab10", vmin=0, vmax=9, s=6)
+            name = "\n".join(textwrap.wrap(m, 24))
+            ax.set_title(f"{name}\ncolour: {col}" if r == 0 else f"colour: {col}", fontsize=8)
+            ax.set_xticks([])
+            ax.set_yticks([])
+    split = max(n - 2, 1)
+    ax = fig.add_subplot(grid[-1, :split])
     for m, res in table.data["curves"].items():
         ax.plot(res.recall, res.precision["mean"], label=f"{m} (AUC {res.auc['mean']:.3f})")
     ax.set_xlabel("recall")
     ax.set_ylabel("precision")
-    ax.legend(fontsize=7)
-    ax.set_title(f"retrieval precision-recall (colour: {col})", fontsize=9)
-    fig.tight_layout()
+    key = fig.add_subplot(grid[-1, split:])  # the legend gets its own cell, beside the curves
+    key.axis("off")
+    key.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="center left")
+    ax.set_title("retrieval precision-recall (labels: " + ", ".join(labels) + ")", fontsize=9)
     return fig
 
 
