@@ -822,6 +822,9 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
                       cache: dict | None = None) -> ExperimentTable:
     """Sec. 5.5 / Fig. 9: sigma_object = (0.1, 0.1, 0.5, 0.5, 1, ...), what each dimension controls.
 
+    The model is trained as the embedding model (sibling-form latent cost, alpha =
+    ``tolerances.EMBEDDING_ALPHA``, hidden layers ``EMBEDDING_HIDDEN``, ``settings.embedding_steps``).
+
     Trains the exploration model on the whole collection, decodes a ``grid x grid`` first level over
     dimensions 1-2 and a second level over 3-4 with 1-2 fixed at ``second_level_point``, and sweeps
     each of ``dims`` alone, measuring height, supporting leg, arm height and facing direction.
@@ -830,8 +833,9 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
+    ep = max(s.min_epochs, int(np.ceil(s.embedding_steps * s.batch_size / len(coll.vertices))))
     model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
-                   prior="sibling")
+                   prior="sibling", alpha=tol.EMBEDDING_ALPHA, hidden=tol.EMBEDDING_HIDDEN, epochs=ep)
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
     regions = ex.humanoid_regions(rest)
     measure = lambda V: ex.measure_humanoid(V, regions)  # noqa: E731
