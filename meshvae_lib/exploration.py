@@ -269,6 +269,9 @@ class DimensionEffects:
     effect : (n_dims, n_measurements) float64, measurement at the top of the range minus at the
         bottom, in units of the measurement's standard deviation over ``reference_std``'s data
     names : list of measurement names
+    span : (n_dims, n_measurements) float64, largest minus smallest measurement over the sweep, in
+        the same units. Unlike ``effect`` it also sees responses that peak inside the range (a
+        dimension that lowers the arms both ways from 0 has a small ``effect`` but a large span).
     """
 
     dims: list
@@ -277,6 +280,7 @@ class DimensionEffects:
     correlation: np.ndarray
     effect: np.ndarray
     names: list = field(default_factory=list)
+    span: np.ndarray | None = None
 
     def rows(self) -> list[dict]:
         """One row per dimension: the measurement it changes most, with correlation and effect."""
@@ -343,4 +347,5 @@ def dimension_effects(model, measure: Callable[[np.ndarray], dict], dims: Sequen
         c, _ = latent_measurement_correlation(values[:, None], {k: M[k][i] for k in names})
         corr[i] = c[0]
         eff[i] = np.array([M[k][i, -1] - M[k][i, 0] for k in names]) / std
-    return DimensionEffects(dims, values, M, corr, eff, names)
+    span = np.stack([np.ptp(M[k], axis=1) for k in names], axis=1) / std
+    return DimensionEffects(dims, values, M, corr, eff, names, span)

@@ -129,3 +129,30 @@ def test_explore_and_dimension_effects_find_the_controls():
     np.testing.assert_allclose(eff.measurements["facing"][1], 20 * np.linspace(-2, 2, 5), atol=1e-9)
     np.testing.assert_allclose(eff.effect[2], 0.0, atol=1e-9)  # dim 3 does nothing
     assert "| 1 | height |" in eff.to_markdown()
+    # for a monotone response the span is the absolute end-to-end change
+    for i, name in ((0, "height"), (1, "facing")):
+        j = eff.names.index(name)
+        assert eff.span[i, j] == pytest.approx(abs(eff.effect[i, j]), rel=1e-12)
+    assert np.all(eff.span >= np.abs(eff.effect) - 1e-12)
+    np.testing.assert_allclose(eff.span[2], 0.0, atol=1e-9)
+
+
+class _BendModel(_FakeModel):
+    """dim 0 turns the body by 20 |z| degrees: a V-shaped response, zero end-to-end change."""
+
+    def decode_latent(self, Z):
+        Z = np.atleast_2d(Z)
+        return np.array([self.V @ _yaw(20 * abs(z[0])).T for z in Z])
+
+
+def test_span_sees_responses_that_peak_inside_the_range():
+    model = _BendModel()
+    r = ex.humanoid_regions(model.V)
+    eff = ex.dimension_effects(model, lambda V: ex.measure_humanoid(V, r), dims=(0,), n_values=5)
+    j = eff.names.index("facing")
+    facing = eff.measurements["facing"][0]
+    np.testing.assert_allclose(facing, 20 * np.abs(np.linspace(-2, 2, 5)), atol=1e-9)
+    assert abs(eff.effect[0, j]) < 1e-9  # the ends agree ...
+    std = np.std(facing)  # no reference meshes: the sweep's own spread is the unit
+    assert eff.span[0, j] == pytest.approx((facing.max() - facing.min()) / std, rel=1e-12)  # ... the span does not
+    assert eff.span[0, j] > 2.0
