@@ -650,7 +650,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     ep = max(s.min_epochs, int(np.ceil(s.embedding_steps * s.batch_size / len(coll.vertices))))
 
     def vae_rows(prior, a, h):
-        """{seed: (embedding, PR result)} for one configuration, and the median seed."""
+        """{seed: (embedding, PR result)} for one configuration, the median seed, and one model."""
         out = {}
         for sd in seeds:
             m = _train(coll, s, cache, ("embedding",), sigma_object=so, holdout=False, prior=prior, alpha=a,
@@ -658,11 +658,10 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
             y = m.encode_meshes(coll.vertices)[:, :2]
             out[sd] = (y, emb.precision_recall_curve(y, labels, relevance=relevance))
         order = sorted(seeds, key=lambda sd: out[sd][1].auc["mean"])
-        return out, order[(len(order) - 1) // 2]
+        return out, order[(len(order) - 1) // 2], m
 
-    ours, med = vae_rows("sibling", alpha, hidden)
-    X = _train(coll, s, cache, ("embedding",), sigma_object=so, holdout=False, prior="sibling", alpha=alpha,
-               hidden=hidden, seed=seeds[0], epochs=ep).features_of(coll.vertices)
+    ours, med, model = vae_rows("sibling", alpha, hidden)
+    X = model.features_of(coll.vertices)  # the normalised rows every model saw (fitted on all meshes)
     k = min(tol.NPE_N_NEIGHBORS, len(X) - 1)
     Y = {
         "sigma_object VAE": ours[med][0],
@@ -679,7 +678,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     if compare_paper_defaults:
         extra.append(("sigma_object VAE, alpha 1e6, no hidden layer", "sibling", tol.DEFAULT_ALPHA, ()))
     for name, prior, a, h in extra:
-        runs, m = vae_rows(prior, a, h)
+        runs, m, _ = vae_rows(prior, a, h)
         Y[name], curves[name] = runs[m]
         seed_aucs[name] = [runs[sd][1].auc["mean"] for sd in seeds]
 
