@@ -50,6 +50,11 @@ class DeformationGradientOperator:
     normal_term : bool
         Include the normal term (default, as the reference implementation). Without it the fit is
         pure Eq. 1 and fails (``ValueError``) at vertices whose one-ring is flat.
+    clamp : bool
+        Clamp the cotangent weights from below (default, see
+        :func:`meshvae_lib.cotangent.cotangent_weights`). ``False`` uses the raw weights of Eq. 1,
+        which are negative across edges opposite obtuse angles and can make ``A_i`` indefinite
+        (for teaching and comparison; notebook 01 shows what goes wrong).
 
     Attributes
     ----------
@@ -60,7 +65,7 @@ class DeformationGradientOperator:
     directed : (2 n_edges, 2) int64
         Directed edges ``(i, j)`` sorted by ``i`` (:func:`meshvae_lib.topology.directed_edges`).
     weights : (n_edges,) float64
-        Clamped cotangent weights ``c_ij``.
+        Cotangent weights ``c_ij`` (clamped unless ``clamp=False``).
     normal_length : float
         ``l``, length of the normal edge.
     normals : (n_vertices, 3) float64
@@ -74,7 +79,7 @@ class DeformationGradientOperator:
         ``w_n A_i^{-1} m_i``: ``T_i = (K p')_i^T + m'_i h_i^T``.
     """
 
-    def __init__(self, V0, F, normal_term: bool = True):
+    def __init__(self, V0, F, normal_term: bool = True, clamp: bool = True):
         V0, F = _check_positions(V0, F)
         if V0.ndim != 2:
             raise ValueError(f"V0 must have shape (n_vertices, 3), got {V0.shape}")
@@ -88,7 +93,7 @@ class DeformationGradientOperator:
         if np.any(counts == 0):
             k = int(np.flatnonzero(counts == 0)[0])
             raise ValueError(f"vertex {k} belongs to no face (unreferenced vertices are not allowed)")
-        self.weights = cotangent_weights(V0, F)
+        self.weights = cotangent_weights(V0, F, clamp=clamp)
         c = self.weights[edge_index(self.edges, D[:, 0], D[:, 1])]  # (2E,)
         e = V0[D[:, 0]] - V0[D[:, 1]]  # e_ij = p_i - p_j, (2E, 3)
         lengths = np.linalg.norm(V0[self.edges[:, 0]] - V0[self.edges[:, 1]], axis=1)
@@ -228,7 +233,7 @@ class DeformationGradientOperator:
         return T[0] if single else T
 
 
-def deformation_gradients(V0, V, F, normal_term: bool = True) -> np.ndarray:
+def deformation_gradients(V0, V, F, normal_term: bool = True, clamp: bool = True) -> np.ndarray:
     """Deformation gradients ``T_i`` taking the reference one-rings to the deformed ones (Eq. 1).
 
     Builds a :class:`DeformationGradientOperator`; keep one yourself to process many meshes.
@@ -240,11 +245,11 @@ def deformation_gradients(V0, V, F, normal_term: bool = True) -> np.ndarray:
     V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
         Deformed mesh(es), same connectivity.
     F : (n_faces, 3) int
-    normal_term : bool
+    normal_term, clamp : bool
         See :class:`DeformationGradientOperator`.
 
     Returns
     -------
     T : (n_vertices, 3, 3) or (n_meshes, n_vertices, 3, 3) float64
     """
-    return DeformationGradientOperator(V0, F, normal_term=normal_term)(V)
+    return DeformationGradientOperator(V0, F, normal_term=normal_term, clamp=clamp)(V)

@@ -47,6 +47,31 @@ def test_vectorised_operator_matches_naive_loop():
                                    _naive(V0, V, F, normal_term), atol=1e-11)
 
 
+def test_raw_weights_match_normal_equations_and_stay_affine_exact():
+    """clamp=False: Eq. (1) with the raw, partly negative cotangent weights, as a loop over vertices
+    (T_i = (sum_j c_ij e'_ij e_ij^T)(sum_j c_ij e_ij e_ij^T)^-1); an affine map is still exact."""
+    V0, F = tube(8, 6)
+    V0 = bumpy(V0, amount=0.5, seed=1)
+    raw = cotangent_weights(V0, F, clamp=False)
+    assert np.sum(raw < 0) >= 10  # the case clamping exists for
+    V = twist_bend(V0, 120, 60)
+    E = edges(F)
+    indptr, ring = one_rings(F, len(V0))
+    expected = []
+    for i in range(len(V0)):
+        A, B = np.zeros((3, 3)), np.zeros((3, 3))
+        for j in ring[indptr[i]:indptr[i + 1]]:
+            c, e, e_def = raw[edge_index(E, i, j)], V0[i] - V0[j], V[i] - V[j]
+            A += c * np.outer(e, e)
+            B += c * np.outer(e_def, e)
+        expected.append(B @ np.linalg.inv(A))
+    T = deformation_gradients(V0, V, F, normal_term=False, clamp=False)
+    np.testing.assert_allclose(T, np.array(expected), atol=1e-9)
+    assert not np.allclose(T, deformation_gradients(V0, V, F, normal_term=False), atol=1e-3)  # clamping matters here
+    T_aff = deformation_gradients(V0, V0 @ AFFINE.T, F, normal_term=False, clamp=False)
+    np.testing.assert_allclose(T_aff, np.broadcast_to(AFFINE, T_aff.shape), atol=1e-9)
+
+
 def test_affine_map_gives_its_matrix_at_every_vertex():
     # pure Eq. 1 reproduces any affine map on curved one-rings
     V0, F = icosphere(2)
