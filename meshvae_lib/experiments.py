@@ -119,6 +119,10 @@ class ExperimentSettings:
         e = int(np.ceil(self.train_steps * self.batch_size / max(int(n_train), 1)))
         return int(np.clip(e, self.min_epochs, self.max_epochs))
 
+    def embedding_epochs_for(self, n_train: int) -> int:
+        """Epochs of the sigma_object models (``embedding_steps``; at least ``min_epochs``)."""
+        return max(self.min_epochs, int(np.ceil(self.embedding_steps * self.batch_size / max(int(n_train), 1))))
+
 
 def _settings(settings, quick) -> ExperimentSettings:
     if settings is not None:
@@ -641,13 +645,13 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     labels = {c: coll.labels[c] for c in label_columns if c in coll.labels}
     if not labels:
         raise ValueError(f"collection {_name_of(collection)!r} has none of the label columns {label_columns};"
-                         f" it has {sorted(labels) or sorted(coll.labels)}")
+                         f" it has {sorted(coll.labels)}")
     seeds = [int(x) for x in seeds]
     if not seeds:
         raise ValueError("give at least one seed")
     D = s.latent_dim
     so = emb.embedding_sigma_object(D)
-    ep = max(s.min_epochs, int(np.ceil(s.embedding_steps * s.batch_size / len(coll.vertices))))
+    ep = s.embedding_epochs_for(len(coll.vertices))
 
     def vae_rows(prior, a, h):
         """{seed: (embedding, PR result)} for one configuration, the median seed, and one model."""
@@ -832,7 +836,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
-    ep = max(s.min_epochs, int(np.ceil(s.embedding_steps * s.batch_size / len(coll.vertices))))
+    ep = s.embedding_epochs_for(len(coll.vertices))
     model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
                    prior="sibling", alpha=tol.EMBEDDING_ALPHA, hidden=tol.EMBEDDING_HIDDEN, epochs=ep)
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
