@@ -13,7 +13,7 @@ import numpy as np
 
 from .alignment import bounding_box_diagonal, rigid_align
 
-__all__ = ["per_vertex_error", "evaluate_model"]
+__all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline"]
 
 
 def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
@@ -74,4 +74,110 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False)
         "names": [names[i] for i in idx] if names else [str(i) for i in idx],
         "indices": [int(i) for i in idx],
         "features": model.extractor_.kind,
+    }
+
+
+class CoordinatePCA:
+    """Linear PCA on vertex coordinates: the linear floor every learned model is compared with.
+
+    Each mesh is flattened to a row of 3n coordinates (optionally after rigidly aligning it to the
+    reference mesh, ``aligned=True``); the rows of the training meshes are centred on their mean
+    and the ``n_components`` leading right singular vectors span the model. A mesh is reconstructed
+    by projecting its centred row orthogonally onto that span and adding the mean back. With
+    ``n_components = N - 1`` (the default, all directions a training set of N meshes spans) the
+    training meshes are reproduced exactly.
+
+    Parameters
+    ----------
+    n_components : int or None
+        number of principal directions kept (None: all that the training meshes span, N - 1 for
+        N meshes in general position).
+    aligned : bool
+        fit and reconstruct rigidly aligned coordinates (the paper's "aligned coordinates").
+
+    Attributes (after :meth:`fit`)
+    ------------------------------
+    mean_ : (3n,) float64, the training meshes' mean row.
+    components_ : (k, 3n) float64, orthonormal principal directions, largest variance first.
+    singular_values_ : (k,) float64.
+    reference_ : (n, 3) float64, the mesh others are aligned to (the first training mesh).
+    """
+
+    def __init__(self, n_components: int | None = None, aligned: bool = False):
+        self.n_components = n_components
+        self.aligned = aligned
+
+    def _rows(self, V) -> np.ndarray:
+        V = np.asarray(V, dtype=np.float64)
+        if V.ndim == 2:
+            V = V[None]
+        if V.ndim != 3 or V.shape[-1] != 3:
+            raise ValueError(f"meshes must have shape (N, n_vertices, 3), got {V.shape}")
+        if hasattr(self, "reference_") and V.shape[1] != len(self.reference_):
+            raise ValueError(f"the PCA was fitted on meshes of {len(self.reference_)} vertices, got {V.shape[1]}")
+        if self.aligned:
+            V = rigid_align(V, self.reference_)
+        return V.reshape(len(V), -1)
+
+    def fit(self, V_train) -> "CoordinatePCA":
+        """V_train : (N, n, 3) float training meshes, N >= 2. Returns ``self``."""
+        V = np.asarray(V_train, dtype=np.float64)
+        if V.ndim != 3 or V.shape[-1] != 3 or len(V) < 2:
+            raise ValueError(f"need (N >= 2, n_vertices, 3) training meshes, got {V.shape}")
+        self.reference_ = V[0].copy()
+        X = self._rows(V)
+        self.mean_ = X.mean(axis=0)
+        _, s, Vt = np.linalg.svd(X - self.mean_, full_matrices=False)
+        rank = int(np.sum(s > s[0] * 1e-12)) if s.size and s[0] > 0 else 0
+        k = rank if self.n_components is None else int(self.n_components)
+        if not 0 <= k <= min(rank, len(V) - 1) and self.n_components is not None:
+            raise ValueError(f"n_components must lie in 0..{min(rank, len(V) - 1)} for these {len(V)} meshes, got {k}")
+        self.components_ = Vt[:k]
+        self.singular_values_ = s[:k]
+        return self
+
+    def transform(self, V) -> np.ndarray:
+        """Meshes (N, n, 3) -> principal coefficients (N, k) float64."""
+        self._check_fitted()
+        return (self._rows(V) - self.mean_) @ self.components_.T
+
+    def inverse_transform(self, Z) -> np.ndarray:
+        """Coefficients (N, k) -> meshes (N, n, 3) float64 (in the aligned frame when ``aligned``)."""
+        self._check_fitted()
+        Z = np.atleast_2d(np.asarray(Z, dtype=np.float64))
+        return (Z @ self.components_ + self.mean_).reshape(len(Z), -1, 3)
+
+    def reconstruct(self, V) -> np.ndarray:
+        """Project meshes (N, n, 3) onto the model and back: (N, n, 3) float64."""
+        return self.inverse_transform(self.transform(V))
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "components_"):
+            raise ValueError("this CoordinatePCA is not fitted yet: call fit(V_train) first")
+
+
+def pca_baseline(V_train, V_eval, n_components: int | None = None, aligned: bool = False) -> dict:
+    """Fit :class:`CoordinatePCA` on training meshes and measure it on others, like :func:`evaluate_model`.
+
+    V_train : (N, n, 3) float training meshes; V_eval : (M, n, 3) float meshes to reconstruct (e.g.
+    the held-out ones); n_components, aligned : see :class:`CoordinatePCA`.
+
+    Returns a dict: ``mean_vertex_error`` (mean over the meshes of the mean vertex distance after
+    rigid alignment, mesh units: the same number :func:`evaluate_model` reports), ``relative_error``,
+    ``train_error`` (the same on ``V_train``), ``n_components``, ``n_meshes``, ``per_mesh`` (list).
+    """
+    pca = CoordinatePCA(n_components, aligned).fit(V_train)
+    Ve = np.asarray(V_eval, dtype=np.float64)
+    Vt = np.asarray(V_train, dtype=np.float64)
+    err = np.atleast_1d(per_vertex_error(pca.reconstruct(Ve), Ve))
+    diag = np.atleast_1d(bounding_box_diagonal(Ve))
+    train = np.atleast_1d(per_vertex_error(pca.reconstruct(Vt), Vt))
+    return {
+        "mean_vertex_error": float(np.mean(err)),
+        "relative_error": float(np.mean(err / diag)),
+        "train_error": float(np.mean(train)),
+        "n_components": int(pca.components_.shape[0]),
+        "aligned": bool(aligned),
+        "n_meshes": int(len(Ve)),
+        "per_mesh": [float(e) for e in err],
     }

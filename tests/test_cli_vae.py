@@ -131,3 +131,26 @@ def test_help_texts_describe_the_commands(capsys):
             main([cmd, "--help"])
         out = capsys.readouterr().out
         assert "examples:" in out and len(out) > 400
+
+
+def test_evaluate_reports_the_pca_baseline(data, capsys):
+    root, path, model, coll = data
+    from meshvae_lib.evaluation import pca_baseline
+
+    capsys.readouterr()
+    assert main(["evaluate", str(model), str(path), "--held-out", "--pca", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    mask = np.zeros(16, bool)
+    mask[3::4] = True
+    expected = pca_baseline(coll.vertices[~mask], coll.vertices[mask])
+    assert res["pca"]["n_components"] == expected["n_components"] == 2  # the strips span two modes
+    assert res["pca"]["mean_vertex_error"] == pytest.approx(expected["mean_vertex_error"], rel=1e-9)
+    # PCA fitted on another file, evaluated on every mesh of DATA
+    train = write_collection(root / "train_part.npz", MeshCollection(coll.vertices[~mask], coll.faces))
+    assert main(["evaluate", str(model), str(path), "--pca", str(train), "--pca-components", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "linear PCA on coordinates (1 components" in out and "model / PCA" in out
+    # without a file, DATA must be the training collection with held-out meshes
+    other = write_collection(root / "few.npz", MeshCollection(coll.vertices[:5], coll.faces))
+    assert main(["evaluate", str(model), str(other), "--pca"]) == 1
+    assert "--pca TRAIN" in capsys.readouterr().err

@@ -74,3 +74,60 @@ def test_evaluate_model_reports_mean_and_per_mesh_numbers(rng):
     model.holdout_mask_ = np.zeros(3, bool)
     with pytest.raises(ValueError, match="trained on 3 meshes"):
         evaluate_model(model, coll, held_out_only=True)
+
+
+# --- linear PCA baseline ------------------------------------------------------------------------
+
+from meshvae_lib.alignment import rigid_align  # noqa: E402
+from meshvae_lib.evaluation import CoordinatePCA, pca_baseline  # noqa: E402
+
+
+def _low_rank_meshes(rng, n=12, nv=30, rank=3, scale=0.05):
+    base = rng.normal(size=(nv, 3))
+    modes = rng.normal(size=(rank, nv, 3))
+    coef = scale * rng.normal(size=(n, rank))
+    return base + np.einsum("nr,rvk->nvk", coef, modes)
+
+
+def test_pca_with_all_components_reproduces_the_training_meshes(rng):
+    V = rng.normal(size=(9, 25, 3))
+    pca = CoordinatePCA().fit(V)
+    assert pca.components_.shape == (8, 75)  # N - 1 directions
+    np.testing.assert_allclose(pca.reconstruct(V), V, atol=1e-12)
+    np.testing.assert_allclose(pca.components_ @ pca.components_.T, np.eye(8), atol=1e-12)
+    res = pca_baseline(V, V)
+    assert res["n_components"] == 8 and res["train_error"] < 1e-12 and res["mean_vertex_error"] < 1e-12
+
+
+def test_pca_held_out_error_matches_a_naive_projection(rng):
+    V = rng.normal(size=(15, 20, 3))
+    train, test = V[:11], V[11:]
+    for k in (None, 4):
+        res = pca_baseline(train, test, n_components=k)
+        # naive reference: centre, eigenvectors of the covariance, project each mesh, align, measure
+        X = train.reshape(11, -1)
+        mean = X.mean(0)
+        w, U = np.linalg.eigh((X - mean).T @ (X - mean))
+        B = U[:, np.argsort(w)[::-1][: (10 if k is None else k)]]
+        expected = []
+        for m in test:
+            r = ((m.ravel() - mean) @ B @ B.T + mean).reshape(-1, 3)
+            r = rigid_align(r, m)
+            expected.append(np.mean([np.linalg.norm(r[i] - m[i]) for i in range(len(m))]))
+        assert res["mean_vertex_error"] == pytest.approx(np.mean(expected), rel=1e-9)
+        np.testing.assert_allclose(res["per_mesh"], expected, rtol=1e-9)
+
+
+def test_pca_recovers_a_low_rank_collection_and_aligned_pca_removes_rigid_motion(rng):
+    V = _low_rank_meshes(rng)
+    res = pca_baseline(V[:8], V[8:], n_components=3)
+    assert res["mean_vertex_error"] < 1e-10
+    R = Rotation.random(len(V), random_state=3).as_matrix()
+    moved = np.einsum("nij,nkj->nki", R, V)
+    raw = pca_baseline(moved[:8], moved[8:], n_components=3)
+    aligned = pca_baseline(moved[:8], moved[8:], n_components=3, aligned=True)
+    assert aligned["mean_vertex_error"] < 0.2 * raw["mean_vertex_error"]
+    with pytest.raises(ValueError, match="n_components"):
+        CoordinatePCA(n_components=20).fit(V[:8])
+    with pytest.raises(ValueError, match="not fitted"):
+        CoordinatePCA().transform(V)

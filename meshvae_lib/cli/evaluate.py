@@ -14,6 +14,13 @@ training collection).
 examples:
   meshvae evaluate scape.pt scape.npz
   meshvae evaluate scape.pt scape.npz --held-out --json
+  meshvae evaluate scape.pt scape.npz --held-out --pca          # + linear PCA on the training meshes
+  meshvae evaluate scape.pt held_out.npz --pca train.npz        # PCA fitted on another file
+
+--pca adds the linear floor: PCA on vertex coordinates fitted on the training meshes (by default
+the meshes of DATA the model did not hold out; or those of the given file), with all the
+directions they span unless --pca-components says otherwise, measured on the same meshes and with
+the same error as the model.
 """
 
 
@@ -25,6 +32,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--held-out", action="store_true", help="only the meshes held out in training")
     p.add_argument("--json", action="store_true",
                    help="print JSON (mean_vertex_error, n_meshes, relative_error, per_mesh, names)")
+    p.add_argument("--pca", nargs="?", const="", default=None, metavar="TRAIN",
+                   help="also report linear PCA on coordinates fitted on the training meshes: those of DATA"
+                        " not held out (no value), or all meshes of the collection TRAIN")
+    p.add_argument("--pca-components", type=int, default=None, metavar="K",
+                   help="principal components of the PCA baseline (default: all the training meshes span)")
     p.set_defaults(func=run)
     return p
 
@@ -37,6 +49,23 @@ def run(args) -> int:
     collection = read_collection(args.data)
     model = load_model(args.model, collection)
     res = evaluate_model(model, collection, held_out_only=args.held_out)
+    if args.pca is not None:
+        import numpy as np
+
+        from ..evaluation import pca_baseline
+
+        if args.pca:
+            train = read_collection(args.pca)
+            model.check_compatible(train)
+            V_train = np.asarray(train.vertices, dtype=np.float64)
+        else:
+            mask = np.asarray(model.holdout_mask_, dtype=bool)
+            if len(mask) != len(collection) or not mask.any():
+                raise ValueError("--pca without a file needs DATA to be the model's training collection with"
+                                 " held-out meshes; give the training meshes: --pca TRAIN")
+            V_train = np.asarray(collection.vertices, dtype=np.float64)[~mask]
+        V_eval = np.asarray(collection.vertices, dtype=np.float64)[res["indices"]]
+        res["pca"] = pca_baseline(V_train, V_eval, n_components=args.pca_components)
     if args.json:
         print(json.dumps(res, indent=2))
     else:
@@ -44,4 +73,9 @@ def run(args) -> int:
         print(f"mean per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
               f" ({100 * res['relative_error']:.3f}% of the bounding-box diagonal; features {res['features']})")
         print(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
+        if "pca" in res:
+            pca = res["pca"]
+            print(f"linear PCA on coordinates ({pca['n_components']} components, fitted on the training meshes):"
+                  f" {pca['mean_vertex_error']:.6g} ({100 * pca['relative_error']:.3f}% of the diagonal);"
+                  f" model / PCA = {res['mean_vertex_error'] / max(pca['mean_vertex_error'], 1e-300):.3g}")
     return 0
