@@ -100,6 +100,9 @@ class MeshVAEModel:
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.training.TrainResult`).
     train_seconds_ : float.
+    train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
+        ``config.epochs``, or 0: the PCA initialisation itself). Not stored in checkpoints.
+    selection_ : early stopping's record (see ``TrainResult.selection``) or None.
     """
 
     def __init__(self, features: str = "rimd", config: TrainConfig | None = None, labels=(),
@@ -135,7 +138,8 @@ class MeshVAEModel:
         self.extractor_ = FeatureExtractor(self.features, self.layout, self.reference_index)
         self.extractor_.fit(V, collection.faces)
         X = self.extractor_.transform(V)
-        self.normalizer_ = FeatureNormalizer().fit(X[~mask])
+        pca = network is None and config.uses_pca_init(len(self.labels))
+        self.normalizer_ = FeatureNormalizer(a=config.resolved_feature_range(pca)).fit(X[~mask])
         Xn = self.normalizer_.transform(X)
         missing = [c for c in self.labels if c not in labels]
         if missing:
@@ -156,6 +160,8 @@ class MeshVAEModel:
         self.network_ = result.model
         self.history_ = result.history
         self.train_seconds_ = result.seconds
+        self.train_epochs_ = result.epochs
+        self.selection_ = result.selection
         self.holdout_mask_ = mask
         self.train_conditions_ = (np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask])
         so = pad_sigma_object(config.sigma_object, self.network_.latent_dim)

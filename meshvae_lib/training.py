@@ -18,10 +18,16 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import torch
 
-from .tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, HIDDEN_COORDS
+from .tolerances import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR,
+                         EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, NORMALIZE_A, PCA_FEATURE_RANGE, PCA_INIT_RTOL,
+                         VALIDATION_EVERY)
 from .vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
 
-__all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object"]
+__all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device",
+           "pad_sigma_object", "pca_network", "INIT_MODES"]
+
+#: how :func:`train_vae` initialises a new network.
+INIT_MODES = ("pca", "random")
 
 logger = logging.getLogger(__name__)
 
@@ -29,8 +35,9 @@ logger = logging.getLogger(__name__)
 def default_hidden(kind: str = "rimd") -> tuple[int, ...]:
     """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
 
-    RIMD: none (the paper's features are already nearly linear in the latent factors; a hidden
-    layer costs about 5x per step at K ~ 165k). Coordinate baselines: HIDDEN_COORDS.
+    None for every kind: with the PCA initialisation (``TrainConfig.init``) a network without
+    internal layers starts at the linear floor, and on the real collections nothing trained from a
+    random start came near it (docs/vae.md, issue 12). Coordinate baselines: HIDDEN_COORDS.
     """
     if kind == "rimd":
         return ()
@@ -58,7 +65,26 @@ class TrainConfig:
     seed : seeds initial weights, shuffling and sampling.
     device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
     progress : show a tqdm progress bar (terminal or notebook).
-    eval_every : evaluate the held-out rows every this many epochs (and at the last epoch).
+    eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
+        how often early stopping looks at its validation meshes.
+    init : "pca" (default) or "random". "pca": an unconditional network without internal layers
+        and with the standard prior (``hidden=()``, ``sigma_object=None``) is built by
+        :func:`pca_network`:
+        its encoder sees the whitened principal coefficients of the training features and its
+        decoder starts as the PCA reconstruction, so training starts at the linear floor. Other
+        networks (internal layers, a sigma_object prior) and ``"random"`` use PyTorch's random
+        initialisation on the K features (the paper's network); so do conditional networks, whose
+        use of the condition has to be learned.
+    feature_range : half-width a of the normalised range (Eq. 3) that
+        :class:`~meshvae_lib.checkpoint.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
+        PCA-initialised networks, the paper's 0.9 otherwise.
+    early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
+        there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
+        row is set aside, a network is trained on the others and evaluated on them (feature MSE,
+        encoded to the mean) before training and every ``eval_every`` epochs, until ``patience``
+        epochs bring no improvement; then a new network is trained on *all* rows for the best
+        number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
+    validation_every, patience : see ``early_stopping``.
     """
 
     epochs: int = DEFAULT_EPOCHS
@@ -73,6 +99,27 @@ class TrainConfig:
     device: str = "auto"
     progress: bool = True
     eval_every: int = 10
+    init: str = "pca"
+    feature_range: float | None = None
+    early_stopping: bool | None = None
+    validation_every: int = VALIDATION_EVERY
+    patience: int = EARLY_STOPPING_PATIENCE
+
+    def uses_pca_init(self, n_conditions: int = 0) -> bool:
+        """True when a new network is built by :func:`pca_network` (see ``init``)."""
+        return self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
+
+    def resolved_feature_range(self, pca: bool | None = None) -> float:
+        """a of Eq. 3 for this config (``pca``: whether the PCA initialisation applies; None: ask)."""
+        if self.feature_range is not None:
+            return float(self.feature_range)
+        pca = self.uses_pca_init() if pca is None else pca
+        return PCA_FEATURE_RANGE if pca else NORMALIZE_A
+
+    def resolved_early_stopping(self, pca: bool | None = None) -> bool:
+        if self.early_stopping is not None:
+            return bool(self.early_stopping)
+        return self.uses_pca_init() if pca is None else bool(pca)
 
     def __post_init__(self):
         self.hidden = tuple(int(h) for h in self.hidden)
@@ -86,6 +133,10 @@ class TrainConfig:
             "latent_dim": self.latent_dim >= 1,
             "eval_every": self.eval_every >= 1,
             "prior_form": self.prior_form in PRIOR_FORMS,
+            "init": self.init in INIT_MODES,
+            "feature_range": self.feature_range is None or 0.0 < float(self.feature_range) < 1.0,
+            "validation_every": self.validation_every >= 2,
+            "patience": self.patience >= 1,
         }
         for name, ok in checks.items():
             if not ok:
@@ -106,14 +157,21 @@ class TrainResult:
     history : one dict per epoch with the training means of ``total``, ``reconstruction``, ``kl``,
         ``mse`` and, on evaluation epochs, ``val_total``, ``val_reconstruction``, ``val_kl``,
         ``val_mse`` (held-out rows, encoded to their mean, no sampling).
-    seconds : wall-clock training time.
+        When the final network was not trained at all (early stopping chose 0 epochs) the history
+        holds one record, epoch 0, with the training rows evaluated at their means.
+    seconds : wall-clock training time (early stopping's selection run included).
     device : where it trained.
+    epochs : epochs the returned network was trained for.
+    selection : early stopping's record, or None when it was off: ``{"epochs": best,
+        "validation_rows": [...], "history": [{"epoch", "val_mse"}, ...]}``.
     """
 
     model: MeshVAE
     history: list[dict] = field(default_factory=list)
     seconds: float = 0.0
     device: str = "cpu"
+    epochs: int = 0
+    selection: dict | None = None
 
 
 def resolve_device(device: str = "auto") -> torch.device:
@@ -172,61 +230,79 @@ def _evaluate(model, x, c, alpha, sigma_object, prior_form) -> dict:
     return {f"val_{k}": float(v) for k, v in parts.items()}
 
 
-def train_vae(
-    features,
-    conditions=None,
-    config: TrainConfig | None = None,
-    val_features=None,
-    val_conditions=None,
-    model: MeshVAE | None = None,
-) -> TrainResult:
-    """Train a mesh VAE on normalised feature rows.
+def pca_network(x: torch.Tensor, config: "TrainConfig", n_conditions: int = 0) -> MeshVAE:
+    """A network without internal layers whose decoded means start as the training rows' PCA.
 
-    Parameters
-    ----------
-    features : (N, K) float, normalised (Eq. 3), N >= 2.
-    conditions : (N, C) float or None (conditional mesh VAE, Eq. 5).
-    config : TrainConfig (defaults when None).
-    val_features, val_conditions : (M, K), (M, C) held-out rows, optional.
-    model : continue training this network instead of building a new one.
+    x : (N, K) float32 normalised training rows (N >= 2); config : the latent size, alpha and
+    sigma_max come from it (``config.hidden`` must be empty). With r = min(D, rank, N - 1)
+    principal directions v_k of the centred rows and their coefficient spreads c_k (singular
+    value / sqrt(N - 1)):
 
-    Returns
-    -------
-    TrainResult with the network (eval mode, CPU) and the per-epoch history.
+    - input projection: ``input_mean`` = the rows' mean, ``input_basis`` row k = v_k / c_k, so the
+      encoder sees whitened coefficients w (unit variance over the training rows, as the prior);
+    - encoder: mu = w in the first r latent dimensions (0 in the others); the deviation is the
+      posterior deviation of a linear-Gaussian model with this decoder and the noise variance
+      K / alpha that Eq. 4 implies, sigma_k = (1 + alpha c_k^2 / K)^(-1/2) (1 in unused
+      dimensions, where the latent cost is then 0);
+    - decoder: pre-activations ``b + W mu`` fitted by least squares to atanh of the training rows,
+      so that tanh(b + W mu) reproduces every training row when r = N - 1.
+
+    Condition inputs (n_conditions > 0) start with zero weights. Returns a MeshVAE in train mode.
     """
-    config = config or TrainConfig()
-    x = _as_tensor(features, "features")
-    n, k = x.shape
-    if n < 2:
-        raise ValueError(f"need at least 2 training meshes, got {n}")
-    c = None if conditions is None else _as_tensor(conditions, "conditions", n)
-    n_cond = 0 if c is None else c.shape[1]
-    xv = None if val_features is None or len(val_features) == 0 else _as_tensor(val_features, "val_features")
-    cv = None
-    if xv is not None and n_cond:
-        if val_conditions is None:
-            raise ValueError("the model is conditional: give val_conditions with val_features")
-        cv = _as_tensor(val_conditions, "val_conditions", xv.shape[0])
+    if config.hidden:
+        raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
+    X = x.detach().double().cpu().numpy()
+    n, k = X.shape
+    mean = X.mean(axis=0)
+    Xc = X - mean
+    # SVD through the small (N, N) Gram matrix: K may be ~1e5-1e6, N ~ 1e2
+    w, U = np.linalg.eigh(Xc @ Xc.T)
+    order = np.argsort(w)[::-1]
+    s = np.sqrt(np.clip(w[order], 0.0, None))
+    U = U[:, order]
+    r = int(min(config.latent_dim, n - 1, np.sum(s > s[0] * PCA_INIT_RTOL))) if s[0] > 0 else 0
+    r = max(r, 1)
+    s_r = np.maximum(s[:r], s[0] * PCA_INIT_RTOL if s[0] > 0 else 1.0)
+    V = (U[:, :r].T @ Xc) / s_r[:, None]  # (r, K) orthonormal directions
+    c = s_r / np.sqrt(max(n - 1, 1))
+    Z = Xc @ V.T / c  # (N, r) whitened coefficients
+    A = np.arctanh(np.clip(X, -1 + 1e-6, 1 - 1e-6))
+    sol, *_ = np.linalg.lstsq(np.c_[Z, np.ones(n)], A, rcond=None)  # (r + 1, K)
+    D = config.latent_dim
+    net = MeshVAE(k, D, (), n_conditions, input_rank=r)
+    sigma = 1.0 / np.sqrt(1.0 + config.alpha * c ** 2 / k)
+    sigma_logit = np.log(sigma / (net.sigma_max - sigma))
+    f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
+    with torch.no_grad():
+        net.input_mean.copy_(f32(mean))
+        net.input_basis.copy_(f32(V / c[:, None]))
+        net.encoder_head.weight.zero_()
+        net.encoder_head.bias.zero_()
+        net.encoder_head.weight[:r, :r] = torch.eye(r)
+        net.encoder_head.bias[D:] = float(np.log(1.0 / (net.sigma_max - 1.0)))  # sigma = 1
+        net.encoder_head.bias[D:D + r] = f32(sigma_logit)
+        net.decoder_head.weight.zero_()
+        net.decoder_head.weight[:, :r] = f32(sol[:r].T)
+        net.decoder_head.bias.copy_(f32(sol[r]))
+    return net
 
-    device = resolve_device(config.device)
-    if model is None:
-        with torch.random.fork_rng(devices=[]):
-            torch.manual_seed(config.seed)
-            model = MeshVAE(k, config.latent_dim, config.hidden, n_cond)
-    elif model.n_features != k or model.n_conditions != n_cond:
-        raise ValueError(
-            f"the given model expects {model.n_features} features and {model.n_conditions} conditions,"
-            f" got {k} and {n_cond}"
-        )
-    so = pad_sigma_object(config.sigma_object, model.latent_dim)
-    so_t = None if so is None else torch.as_tensor(so, dtype=torch.float32, device=device)
-    model.to(device)
-    x = x.to(device)
-    c = None if c is None else c.to(device)
-    if xv is not None:
-        xv = xv.to(device)
-        cv = None if cv is None else cv.to(device)
 
+def _new_network(x, n_cond, config, pca: bool) -> MeshVAE:
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(config.seed)
+        if pca:
+            return pca_network(x, config, n_cond)
+        return MeshVAE(x.shape[1], config.latent_dim, config.hidden, n_cond)
+
+
+def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, select=False, desc="training mesh VAE"):
+    """Train ``model`` in place for up to ``epochs`` epochs. Returns (history, best_epoch).
+
+    With ``select`` the validation rows (xv, cv) are evaluated before training and every
+    ``eval_every`` epochs; training stops after ``config.patience`` epochs without a lower
+    validation MSE, and best_epoch is the epoch of the lowest (0: before training).
+    """
+    n = x.shape[0]
     optimizer = torch.optim.Adam(model.parameters(), lr=config.lr, fused=True)
     shuffle_gen = torch.Generator().manual_seed(config.seed + 1)
     noise_gen = torch.Generator(device=device).manual_seed(config.seed + 2)
@@ -234,8 +310,11 @@ def train_vae(
     from tqdm.auto import tqdm
 
     history: list[dict] = []
-    t0 = time.perf_counter()
-    bar = tqdm(range(config.epochs), desc="training mesh VAE", unit="epoch", disable=not config.progress)
+    best_epoch, best_val = 0, np.inf
+    if select:
+        best_val = _evaluate(model, xv, cv, config.alpha, so_t, config.prior_form)["val_mse"]
+        history.append({"epoch": 0, "val_mse": best_val})
+    bar = tqdm(range(epochs), desc=desc, unit="epoch", disable=not config.progress)
     for epoch in bar:
         model.train()
         sums = {"total": 0.0, "reconstruction": 0.0, "kl": 0.0, "mse": 0.0}
@@ -256,8 +335,17 @@ def train_vae(
             bar.close()
             raise ValueError(f"training diverged at epoch {epoch + 1} (loss {sums['total']}); try a smaller"
                              f" learning rate (now {config.lr:g}) or alpha (now {config.alpha:g})")
+        last = epoch + 1 == epochs
+        if select:
+            if (epoch + 1) % config.eval_every == 0 or last:
+                val = _evaluate(model, xv, cv, config.alpha, so_t, config.prior_form)["val_mse"]
+                history.append({"epoch": epoch + 1, "mse": sums["mse"], "val_mse": val})
+                if val < best_val:
+                    best_epoch, best_val = epoch + 1, val
+                elif epoch + 1 - best_epoch >= config.patience:
+                    break
+            continue
         record = {"epoch": epoch + 1, **sums}
-        last = epoch + 1 == config.epochs
         if xv is not None and ((epoch + 1) % config.eval_every == 0 or last):
             record.update(_evaluate(model, xv, cv, config.alpha, so_t, config.prior_form))
         history.append(record)
@@ -268,8 +356,98 @@ def train_vae(
                 post["val_mse"] = f"{record['val_mse']:.3g}"
             bar.set_postfix(post, refresh=False)
     bar.close()
+    return history, best_epoch
+
+
+def train_vae(
+    features,
+    conditions=None,
+    config: TrainConfig | None = None,
+    val_features=None,
+    val_conditions=None,
+    model: MeshVAE | None = None,
+) -> TrainResult:
+    """Train a mesh VAE on normalised feature rows.
+
+    Parameters
+    ----------
+    features : (N, K) float, normalised (Eq. 3), N >= 2.
+    conditions : (N, C) float or None (conditional mesh VAE, Eq. 5).
+    config : TrainConfig (defaults when None): with the defaults a network without internal layers
+        is PCA-initialised (:func:`pca_network`) and the number of epochs is chosen by early
+        stopping on every ``validation_every``-th training row (see :class:`TrainConfig`).
+    val_features, val_conditions : (M, K), (M, C) held-out rows, optional: only recorded in the
+        history (``val_*``), never used to choose anything.
+    model : continue training this network instead of building a new one (no PCA initialisation
+        and no early stopping then, unless ``config.early_stopping`` is True, which is refused).
+
+    Returns
+    -------
+    TrainResult with the network (eval mode, CPU), the per-epoch history, the number of epochs and
+    early stopping's record.
+    """
+    config = config or TrainConfig()
+    x = _as_tensor(features, "features")
+    n, k = x.shape
+    if n < 2:
+        raise ValueError(f"need at least 2 training meshes, got {n}")
+    c = None if conditions is None else _as_tensor(conditions, "conditions", n)
+    n_cond = 0 if c is None else c.shape[1]
+    xv = None if val_features is None or len(val_features) == 0 else _as_tensor(val_features, "val_features")
+    cv = None
+    if xv is not None and n_cond:
+        if val_conditions is None:
+            raise ValueError("the model is conditional: give val_conditions with val_features")
+        cv = _as_tensor(val_conditions, "val_conditions", xv.shape[0])
+
+    device = resolve_device(config.device)
+    pca = model is None and config.uses_pca_init(n_cond)
+    if model is not None:
+        if config.early_stopping:
+            raise ValueError("early stopping builds its own networks; it cannot continue a given model")
+        if model.n_features != k or model.n_conditions != n_cond:
+            raise ValueError(
+                f"the given model expects {model.n_features} features and {model.n_conditions} conditions,"
+                f" got {k} and {n_cond}"
+            )
+    early = model is None and config.resolved_early_stopping(pca) and n >= 2 * config.validation_every
+    latent = model.latent_dim if model is not None else config.latent_dim
+    so = pad_sigma_object(config.sigma_object, latent)
+    so_t = None if so is None else torch.as_tensor(so, dtype=torch.float32, device=device)
+
+    t0 = time.perf_counter()
+    epochs, selection = config.epochs, None
+    if early:
+        vmask = np.zeros(n, dtype=bool)
+        vmask[config.validation_every - 1 :: config.validation_every] = True
+        fit_i, val_i = torch.from_numpy(np.flatnonzero(~vmask)), torch.from_numpy(np.flatnonzero(vmask))
+        probe = _new_network(x[fit_i], n_cond, config, pca).to(device)
+        sel_history, epochs = _run(probe, x[fit_i].to(device), None if c is None else c[fit_i].to(device), config,
+                                   config.epochs, device, x[val_i].to(device),
+                                   None if c is None else c[val_i].to(device), so_t, select=True,
+                                   desc="choosing epochs")
+        selection = {"epochs": int(epochs), "validation_rows": [int(i) for i in val_i], "history": sel_history}
+        logger.info("early stopping chose %d epochs (validation MSE %s)", epochs,
+                    min(h["val_mse"] for h in sel_history))
+        del probe
+    if model is None:
+        model = _new_network(x, n_cond, config, pca)
+    model.to(device)
+    x = x.to(device)
+    c = None if c is None else c.to(device)
+    if xv is not None:
+        xv = xv.to(device)
+        cv = None if cv is None else cv.to(device)
+    history, _ = _run(model, x, c, config, epochs, device, xv, cv, so_t)
+    if not history:  # not trained at all: record the starting point
+        record = {"epoch": 0, **{k_[4:]: v for k_, v in _evaluate(model, x, c, config.alpha, so_t,
+                                                                    config.prior_form).items()}}
+        if xv is not None:
+            record.update(_evaluate(model, xv, cv, config.alpha, so_t, config.prior_form))
+        history.append(record)
     seconds = time.perf_counter() - t0
-    logger.info("trained %d epochs in %.1f s on %s; final %s", config.epochs, seconds, device, history[-1])
+    logger.info("trained %d epochs in %.1f s on %s; final %s", epochs, seconds, device, history[-1])
     model.eval()
     model.to("cpu")
-    return TrainResult(model=model, history=history, seconds=seconds, device=str(device))
+    return TrainResult(model=model, history=history, seconds=seconds, device=str(device), epochs=int(epochs),
+                       selection=selection)

@@ -20,7 +20,9 @@ def _data(n=48, k=60, seed=0):
 
 def test_tiny_training_run_lowers_the_loss_and_records_history():
     X = _data()
-    res = train_vae(X[:40], config=TrainConfig(epochs=60, latent_dim=6, batch_size=8, progress=False, eval_every=20),
+    # the optimisation loop itself: the paper's random start, no early stopping
+    res = train_vae(X[:40], config=TrainConfig(epochs=60, latent_dim=6, batch_size=8, progress=False, eval_every=20,
+                                               init="random", early_stopping=False),
                     val_features=X[40:])
     h = res.history
     assert len(h) == 60 and [r["epoch"] for r in h] == list(range(1, 61))
@@ -137,3 +139,97 @@ def test_divergence_stops_with_a_clear_error():
     X = _data(n=8, k=10)
     with pytest.raises(ValueError, match=r"diverged at epoch \d+ \(loss nan\); try a smaller learning rate"):
         train_vae(X, config=TrainConfig(epochs=3, latent_dim=2, lr=1e30, alpha=1e30, progress=False))
+
+
+# --- PCA initialisation and early stopping (issue 12) ---------------------------------------------
+
+from meshvae_lib.training import pca_network  # noqa: E402
+from meshvae_lib.vae import MeshVAE  # noqa: E402
+
+
+def _in_range(n=30, k=80, rank=5, seed=1, a=0.3):
+    rng = np.random.default_rng(seed)
+    X = rng.normal(size=(n, rank)) @ rng.normal(size=(rank, k)) + 0.01 * rng.normal(size=(n, k))
+    return FeatureNormalizer(a=a).fit_transform(X)
+
+
+def test_pca_network_starts_at_the_pca_reconstruction():
+    X = _in_range()
+    x = torch.from_numpy(X.astype(np.float32))
+    cfg = TrainConfig(latent_dim=40, progress=False)
+    net = pca_network(x, cfg).eval()
+    assert net.input_rank == 29 and net.config()["input_rank"] == 29  # min(D, N - 1)
+    with torch.no_grad():
+        mu, sigma = net.encode(x)
+        rec = net.decode(mu).double().numpy()
+    # r = N - 1: every training row comes back (float32 round-off through atanh / tanh)
+    np.testing.assert_allclose(rec, X, atol=2e-4)
+    # whitened coefficients: unit spread over the training rows, unused dimensions exactly 0
+    np.testing.assert_allclose(mu[:, :29].double().std(0, unbiased=True).numpy(), 1.0, atol=1e-3)
+    assert torch.all(mu[:, 29:] == 0)
+    # deviations: the linear-Gaussian posterior (1 + alpha c^2 / K)^(-1/2), 1 where unused
+    np.testing.assert_allclose(sigma[:, 29:].numpy(), 1.0, atol=1e-6)
+    c = np.linalg.svd(X - X.mean(0), compute_uv=False)[:29] / np.sqrt(29)
+    np.testing.assert_allclose(sigma[0, :29].double().numpy(), 1 / np.sqrt(1 + cfg.alpha * c ** 2 / 80), rtol=1e-3)
+    # the encoder ignores what lies outside the training rows' span
+    rng = np.random.default_rng(0)
+    e = rng.normal(size=80)
+    e -= (X - X.mean(0)).T @ np.linalg.lstsq((X - X.mean(0)).T, e, rcond=None)[0]
+    shifted = torch.from_numpy((X[:3] + 0.5 * e / np.linalg.norm(e)).astype(np.float32))
+    with torch.no_grad():
+        np.testing.assert_allclose(net.encode(shifted)[0].numpy(), mu[:3].numpy(), atol=3e-3)  # float32
+    with pytest.raises(ValueError, match="internal layers"):
+        pca_network(x, TrainConfig(hidden=(8,)))
+    with pytest.raises(ValueError, match="input_rank"):
+        MeshVAE(10, 4, input_rank=11)
+
+
+def test_defaults_choose_the_epochs_by_early_stopping_on_training_rows():
+    X = _in_range(n=40)
+    cfg = TrainConfig(epochs=50, latent_dim=8, progress=False, eval_every=5, patience=20)
+    assert cfg.uses_pca_init() and cfg.resolved_early_stopping() and cfg.resolved_feature_range() == 0.3
+    res = train_vae(X, config=cfg, val_features=X[:2])
+    sel = res.selection
+    assert sel["validation_rows"] == [7, 15, 23, 31, 39]  # every 8th training row
+    epochs = [h["epoch"] for h in sel["history"]]
+    assert epochs[0] == 0 and all(e % 5 == 0 for e in epochs) and epochs[-1] <= 50
+    best = min(sel["history"], key=lambda h: h["val_mse"])
+    assert res.epochs == sel["epochs"] == best["epoch"]
+    # stops once patience epochs bring nothing better
+    assert epochs[-1] == 50 or epochs[-1] - res.epochs >= 20
+    # the final network was trained on all rows for the chosen number of epochs
+    assert res.model.input_rank == 8
+    assert len(res.history) == max(res.epochs, 1) and res.history[-1]["epoch"] == res.epochs
+    assert "val_mse" in res.history[-1]
+    # same seed, same result
+    again = train_vae(X, config=cfg, val_features=X[:2])
+    assert again.epochs == res.epochs
+    assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), again.model.state_dict().values()))
+
+
+def test_zero_chosen_epochs_returns_the_initialisation_with_an_epoch_0_record():
+    X = _in_range(n=24)
+    cfg = TrainConfig(epochs=30, latent_dim=6, progress=False, lr=1.0, eval_every=5, patience=10)  # lr 1: ruins it
+    res = train_vae(X, config=cfg)
+    assert res.epochs == 0 and len(res.history) == 1 and res.history[0]["epoch"] == 0
+    init = pca_network(torch.from_numpy(X.astype(np.float32)), cfg)
+    assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), init.state_dict().values()))
+    assert res.history[0]["total"] == pytest.approx(res.history[0]["reconstruction"] + res.history[0]["kl"], rel=1e-6)
+
+
+def test_which_networks_get_the_pca_start_and_new_config_checks():
+    assert not TrainConfig(hidden=(8,)).uses_pca_init()
+    assert not TrainConfig(sigma_object=(0.1,)).uses_pca_init()
+    assert not TrainConfig(init="random").uses_pca_init()
+    assert not TrainConfig().uses_pca_init(n_conditions=2)
+    assert TrainConfig(hidden=(8,)).resolved_feature_range() == 0.9  # the paper's a
+    assert not TrainConfig(hidden=(8,)).resolved_early_stopping()
+    assert TrainConfig(feature_range=0.5).resolved_feature_range() == 0.5
+    X = _data(n=20, k=30)
+    res = train_vae(X, config=TrainConfig(epochs=3, hidden=(8,), progress=False))
+    assert res.selection is None and res.epochs == 3 and res.model.input_rank == 0
+    for bad in (dict(init="zeros"), dict(feature_range=1.0), dict(validation_every=1), dict(patience=0)):
+        with pytest.raises(ValueError):
+            TrainConfig(**bad)
+    with pytest.raises(ValueError, match="early stopping"):
+        train_vae(X, config=TrainConfig(early_stopping=True, progress=False), model=MeshVAE(30, 4))

@@ -14,6 +14,9 @@ Train a mesh VAE (Tan et al., CVPR 2018) on a collection of meshes that share on
 and write everything needed to use it (weights, normaliser, reference mesh, faces, labels) to one
 checkpoint file. DATA is an .npz collection or a folder of OBJ/PLY/OFF files (+ labels.csv).
 The defaults train a good model for 50-200 meshes; a progress bar shows the epochs.
+By default the network (no internal layers, standard prior, unconditional) starts as the PCA of
+the training features and early stopping on every 8th training mesh chooses how many of the
+--epochs to train (possibly none); see docs/vae.md for why.
 
 examples:
   meshvae train scape.npz -o scape.pt
@@ -46,12 +49,16 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    " rigidly aligned or raw vertex coordinates (default: rimd)")
     p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
-                   help=f"training epochs (default {d.epochs})")
+                   help=f"training epochs, the most early stopping may choose (default {d.epochs})")
+    p.add_argument("--init", choices=("pca", "random"), default=d.init,
+                   help="pca (default): start from the PCA of the training features (networks without internal"
+                        " layers, standard prior, no labels); random: PyTorch's initialisation (the paper)")
+    p.add_argument("--no-early-stopping", action="store_true",
+                   help="train all --epochs instead of choosing them on every 8th training mesh")
     p.add_argument("--alpha", type=float, default=DEFAULT_ALPHA, metavar="A",
                    help=f"weight of the reconstruction term, Eq. 4 (default {DEFAULT_ALPHA:g})")
     p.add_argument("--hidden", type=int, nargs="*", default=None, metavar="H",
-                   help="internal layer sizes, outermost first (default: none for rimd; see docs/vae.md"
-                   " for the coordinate baselines)")
+                   help="internal layer sizes, outermost first (default: none; see docs/vae.md)")
     p.add_argument("--batch-size", type=int, default=d.batch_size, metavar="B", help=f"default {d.batch_size}")
     p.add_argument("--lr", type=float, default=d.lr, help=f"Adam learning rate (default {d.lr:g})")
     p.add_argument("--holdout-every", type=int, default=0, metavar="K",
@@ -88,14 +95,18 @@ def run(args) -> int:
     hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features)
     config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
                          latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
-                         prior_form=args.prior_form, seed=args.seed,
+                         prior_form=args.prior_form, seed=args.seed, init=args.init,
+                         early_stopping=False if args.no_early_stopping else None,
                          device=args.device, progress=not args.no_progress)
     print(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
-          f" latent {args.latent}, hidden {list(hidden)}, {epochs} epochs")
+          f" latent {args.latent}, hidden {list(hidden)}, at most {epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference).fit(collection)
     model.save(args.output)
     last = model.history_[-1]
+    if model.selection_ is not None:
+        print(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
+              f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
     print(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.network_.n_features}")
     if model.holdout_mask_.any():
