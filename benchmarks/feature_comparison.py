@@ -1,14 +1,22 @@
-"""RIMD against aligned and raw vertex coordinates: the experiment of the paper's Table 3.
+"""RIMD against aligned and raw vertex coordinates and linear PCA: the experiment of the paper's Table 2/3.
 
-The same mesh VAE is trained on three inputs of one ``data_synth`` collection with large rotations:
-raw 3D coordinates, coordinates after rigidly aligning every mesh to the reference, and RIMD
-features. Every ``--holdout-every``-th mesh is held out; the table gives the mean per-vertex error
-of the held-out meshes (encoded to the latent mean, decoded, aligned rigidly to the truth), in the
-mesh's units and relative to the bounding-box diagonal, and the training time. For the coordinate
-baselines several layer settings are tried and the best is kept (the paper adjusts their layers
-"to optimize their performance").
+The same mesh VAE (library defaults unless told otherwise) is trained on three inputs of each
+collection: raw 3D coordinates, coordinates after rigidly aligning every mesh to the reference, and
+RIMD features. Every ``--holdout-every``-th mesh is held out (``training.holdout_mask``); the table
+gives, per feature kind, the mean per-vertex error of the training and of the held-out meshes
+(encoded to the latent mean, decoded, aligned rigidly to the truth, as ``meshvae evaluate``
+measures it), in the mesh's units, the training time (features + training) and the epochs early
+stopping chose. Two linear rows close each table: PCA on coordinates and on aligned coordinates,
+fitted on the training meshes with every direction they span (``evaluation.pca_baseline``).
 
-    .venv/bin/python benchmarks/feature_comparison.py [--collection scape] [--resolution 500] [--threads 2]
+Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
+repository) when that folder exists, else a ``data_synth`` collection. ``--legacy`` trains with the
+defaults before issue 12 (random initialisation, all epochs, a = 0.9, a hidden layer of 256 for the
+coordinate kinds) to show the difference.
+
+    python benchmarks/feature_comparison.py                              # real collections if present
+    python benchmarks/feature_comparison.py --real pcow --subsample 3    # every 3rd frame of pcow
+    python benchmarks/feature_comparison.py --synth scape --resolution 500
 
 Measured results and their settings: docs/vae.md.
 """
@@ -16,86 +24,123 @@ Measured results and their settings: docs/vae.md.
 from __future__ import annotations
 
 import argparse
+import json
 import logging
+import os
 import time
+from pathlib import Path
 
 import numpy as np
 import torch
 
 from meshvae_lib.checkpoint import MeshVAEModel
-from meshvae_lib.evaluation import evaluate_model
-from meshvae_lib.training import TrainConfig
+from meshvae_lib.evaluation import evaluate_model, pca_baseline
+from meshvae_lib.mesh_io import MeshCollection
+from meshvae_lib.training import TrainConfig, holdout_mask
+
+SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+REAL = ("samba", "pdance", "pcow")
+KINDS = ("coords", "aligned", "rimd")
 
 
-def run_one(coll, kind: str, hidden, epochs: int, every: int, seed: int, latent: int, batch_size: int, lr: float):
-    cfg = TrainConfig(epochs=epochs, hidden=hidden, seed=seed, latent_dim=latent, progress=False,
-                      batch_size=batch_size, lr=lr)
-    t0 = time.perf_counter()
-    model = MeshVAEModel(kind, cfg, holdout_every=every).fit(coll)
-    seconds = time.perf_counter() - t0  # features + training
-    res = evaluate_model(model, coll, held_out_only=True)
-    train = evaluate_model(model, coll, indices=np.flatnonzero(~model.holdout_mask_))
-    return res, train["mean_vertex_error"], seconds, model
+def load_real(name: str, subsample: int = 1) -> MeshCollection:
+    d = np.load(SHARED_DATA / f"{name}.npz")
+    V = np.asarray(d["vertices"], dtype=np.float64)[::subsample]
+    return MeshCollection(V, np.asarray(d["faces"]), names=[str(n) for n in np.asarray(d["names"])[::subsample]])
+
+
+def config_for(kind: str, legacy: bool, seed: int, epochs: int | None) -> TrainConfig:
+    extra = {} if epochs is None else {"epochs": epochs}
+    if legacy:
+        hidden = () if kind == "rimd" else (256,)
+        return TrainConfig(hidden=hidden, init="random", early_stopping=False, feature_range=0.9, seed=seed,
+                           progress=False, device="cpu", **extra)
+    return TrainConfig(seed=seed, progress=False, device="cpu", **extra)
+
+
+def run_collection(coll, name: str, args) -> list[dict]:
+    V = np.asarray(coll.vertices, dtype=np.float64)
+    mask = holdout_mask(len(V), args.holdout_every)
+    diag = float(np.mean(np.linalg.norm(np.ptp(V, axis=1), axis=1)))
+    print(f"\n{name}: {len(V)} meshes ({int((~mask).sum())} train / {int(mask.sum())} held out), {V.shape[1]} vertices,"
+          f" mean bounding-box diagonal {diag:.4g}; {'legacy' if args.legacy else 'library'} defaults,"
+          f" {torch.get_num_threads()} thread(s)", flush=True)
+    print(f"{'features':18s} {'K':>7s} {'train error':>12s} {'held-out':>10s} {'% diag':>7s} {'epochs':>6s} {'time (s)':>9s}",
+          flush=True)
+    rows = []
+    for kind in args.kinds.split(","):
+        t0 = time.perf_counter()
+        model = MeshVAEModel(kind, config_for(kind, args.legacy, args.seed, args.epochs),
+                             holdout_every=args.holdout_every).fit(coll)
+        seconds = time.perf_counter() - t0
+        held = evaluate_model(model, coll, held_out_only=True)
+        train = evaluate_model(model, coll, indices=np.flatnonzero(~model.holdout_mask_))
+        row = {"collection": name, "features": kind, "K": int(model.network_.n_features),
+               "train_error": train["mean_vertex_error"], "held_out_error": held["mean_vertex_error"],
+               "relative_error": held["relative_error"], "epochs": int(model.train_epochs_), "seconds": seconds}
+        rows.append(row)
+        print(f"{kind:18s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
+              f" {100 * row['relative_error']:7.3f} {row['epochs']:6d} {seconds:9.1f}", flush=True)
+    latent = TrainConfig().latent_dim
+    pcas = [(False, None), (True, None)]
+    if int((~mask).sum()) - 1 > latent:  # the VAE has only D latent dimensions: PCA with as many too
+        pcas += [(False, latent), (True, latent)]
+    for aligned, k in pcas:
+        t0 = time.perf_counter()
+        res = pca_baseline(V[~mask], V[mask], n_components=k, aligned=aligned)
+        label = ("PCA aligned" if aligned else "PCA coords") + ("" if k is None else f" k={k}")
+        row = {"collection": name, "features": label, "K": 3 * V.shape[1], "train_error": res["train_error"],
+               "held_out_error": res["mean_vertex_error"], "relative_error": res["relative_error"],
+               "epochs": 0, "seconds": time.perf_counter() - t0, "n_components": res["n_components"]}
+        rows.append(row)
+        print(f"{label:18s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
+              f" {100 * row['relative_error']:7.3f} {'':>6s} {row['seconds']:9.1f}   ({res['n_components']} components)",
+              flush=True)
+    err = {r["features"]: r["held_out_error"] for r in rows}
+    if all(k in err for k in KINDS):
+        r, a, c, p = err["rimd"], err["aligned"], err["coords"], err["PCA coords"]
+        print(f"RIMD held-out error is {100 * (1 - r / c):.0f}% lower than 3D coordinates' (paper: 59 to 94% lower)"
+              f" and {100 * (1 - r / a):.0f}% lower than aligned coordinates' (paper: 27 to 72%; negative: higher);"
+              f" RIMD / PCA on coordinates = {r / p:.3g}; order RIMD < aligned < coords: {'yes' if r < a < c else 'NO'}",
+              flush=True)
+    return rows
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--collection", default="scape", help="data_synth collection (default: scape)")
-    ap.add_argument("--resolution", type=int, default=500,
-                    help="template vertex count (default 500, keeps the run to a few minutes; 0: the collection's)")
-    ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
+    ap.add_argument("--real", default=None,
+                    help=f"comma-separated collections of {SHARED_DATA} (default: {','.join(REAL)} when present)")
+    ap.add_argument("--synth", default=None,
+                    help="use this data_synth collection instead of the real ones (default when no real data: scape)")
+    ap.add_argument("--resolution", type=int, default=500, help="data_synth template vertex count (0: its own)")
+    ap.add_argument("--subsample", type=int, default=1, help="keep every k-th mesh of a real collection")
     ap.add_argument("--holdout-every", type=int, default=5)
-    ap.add_argument("--latent", type=int, default=128)
+    ap.add_argument("--kinds", default=",".join(KINDS))
+    ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
+    ap.add_argument("--legacy", action="store_true", help="the training defaults before issue 12")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--coords-hidden", default="none,256",
-                    help="layer settings tried for the coordinate baselines, e.g. 'none,256,1024-256'")
-    ap.add_argument("--rimd-hidden", default="none", help="layer settings tried for RIMD, e.g. 'none,256'")
-    ap.add_argument("--batch-size", type=int, default=TrainConfig().batch_size)
-    ap.add_argument("--lr", type=float, default=TrainConfig().lr)
-    ap.add_argument("--kinds", default="coords,aligned,rimd", help="feature kinds to run")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--json", default=None, metavar="OUT.json", help="also write the rows as JSON")
     args = ap.parse_args()
+    os.environ.setdefault("OMP_NUM_THREADS", str(args.threads))
     torch.set_num_threads(args.threads)
     logging.basicConfig(level=logging.WARNING)
 
-    from data_synth.registry import make_collection
-
-    coll = make_collection(args.collection, seed=args.seed, resolution=args.resolution or None)
-    epochs = args.epochs or TrainConfig().epochs
-    diag = float(np.mean(np.linalg.norm(np.ptp(coll.vertices, axis=1), axis=1)))
-    print(f"collection {args.collection!r}: {coll.vertices.shape[0]} meshes, {coll.vertices.shape[1]} vertices,"
-          f" mean bounding-box diagonal {diag:.4g}; held out every {args.holdout_every}th;"
-          f" {epochs} epochs, batch {args.batch_size}, lr {args.lr:g}, latent {args.latent},"
-          f" {torch.get_num_threads()} threads\n")
-    settings = [("coords", h) for h in args.coords_hidden.split(",")] + \
-               [("aligned", h) for h in args.coords_hidden.split(",")] + \
-               [("rimd", h) for h in args.rimd_hidden.split(",")]
-    settings = [(k, h) for k, h in settings if k in args.kinds.split(",")]
     rows = []
-    print(f"{'features':9s} {'hidden':>9s} {'K':>7s} {'held-out error':>15s} {'% diag':>8s} {'train error':>12s} {'time (s)':>9s}")
-    for kind, h in settings:
-        hidden = () if h == "none" else tuple(int(x) for x in h.split("-"))
-        res, train_err, seconds, model = run_one(coll, kind, hidden, epochs, args.holdout_every, args.seed, args.latent,
-                                                  args.batch_size, args.lr)
-        rows.append((kind, h, res["mean_vertex_error"], seconds))
-        print(f"{kind:9s} {h:>9s} {model.network_.n_features:7d} {res['mean_vertex_error']:15.5g}"
-              f" {100 * res['relative_error']:8.3f} {train_err:12.5g} {seconds:9.1f}", flush=True)
+    names = args.real.split(",") if args.real else ([] if args.synth else
+                                                      [n for n in REAL if (SHARED_DATA / f"{n}.npz").exists()])
+    if names:
+        for name in names:
+            rows += run_collection(load_real(name, args.subsample), name + (f"/{args.subsample}" if args.subsample > 1 else ""),
+                                   args)
+    else:
+        from data_synth.registry import make_collection
 
-    best = {}
-    for kind, h, err, sec in rows:
-        if kind not in best or err < best[kind][1]:
-            best[kind] = (h, err, sec)
-    print("\nbest per feature kind (held-out mean per-vertex error):")
-    for kind in [k for k in ("coords", "aligned", "rimd") if k in best]:
-        h, err, sec = best[kind]
-        print(f"  {kind:8s} {err:.5g}  (hidden {h}, {sec:.0f} s)")
-    if len(best) < 3:
-        return
-    r, a, c = best["rimd"][1], best["aligned"][1], best["coords"][1]
-    print(f"\nRIMD is {100 * (1 - r / c):.0f}% lower than 3D coordinates (paper: 59-94%) and"
-          f" {100 * (1 - r / a):.0f}% lower than aligned coordinates (paper: 27-72%);"
-          f" aligned is {100 * (1 - a / c):.0f}% lower than 3D coordinates.")
-    print("order RIMD < aligned < coords:", "yes" if r < a < c else "NO")
+        synth = args.synth or "scape"
+        coll = make_collection(synth, seed=args.seed, resolution=args.resolution or None)
+        rows += run_collection(coll, synth, args)
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=2))
 
 
 if __name__ == "__main__":
