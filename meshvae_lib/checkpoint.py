@@ -139,7 +139,8 @@ class MeshVAEModel:
         self.extractor_.fit(V, collection.faces)
         X = self.extractor_.transform(V)
         pca = network is None and config.uses_pca_init(len(self.labels))
-        self.normalizer_ = FeatureNormalizer(a=config.resolved_feature_range(pca)).fit(X[~mask])
+        self.normalizer_ = FeatureNormalizer(a=config.resolved_feature_range(pca),
+                                             scale=config.resolved_feature_scale(self.features, pca)).fit(X[~mask])
         Xn = self.normalizer_.transform(X)
         missing = [c for c in self.labels if c not in labels]
         if missing:

@@ -10,7 +10,14 @@ the training set (max = min = c) is treated as spanning [c - eps, c + eps] (eps 
 to 0 and the inverse maps the decoder's output back near c.
 
 (The authors' sibling projects use one global min/max for all rotation entries and one for all
-scaling entries, mapped to ±0.95; this module follows the paper.)
+scaling entries, mapped to ±0.95; this module follows the paper by default.)
+
+``scale="shared"`` keeps each component's own centre (the midpoint of its training range) but
+gives every component the same half-width, the largest one: a component that barely moves over
+the training set then stays near 0 instead of being stretched to [-a, a]. For vertex coordinates
+this keeps the squared error of the normalised rows proportional to the squared vertex error; the
+per-component scaling of the paper weights a vertex that barely moves as much as one that moves a
+lot, and made linear models on real collections up to 1.8x worse (docs/vae.md, issue 12).
 """
 
 from __future__ import annotations
@@ -19,7 +26,10 @@ import numpy as np
 
 from .tolerances import NORMALIZE_A, NORMALIZE_EPS
 
-__all__ = ["FeatureNormalizer"]
+__all__ = ["FeatureNormalizer", "SCALES"]
+
+#: how the per-component ranges are set: the paper's own range per component, or one shared width.
+SCALES = ("component", "shared")
 
 
 class FeatureNormalizer:
@@ -31,6 +41,8 @@ class FeatureNormalizer:
         half-width of the target range, 0 < a < 1 (paper: 0.9).
     eps : float
         a component constant over the training set is widened to [c - eps, c + eps] (paper: 1e-6).
+    scale : "component" (the paper) or "shared": every component gets the largest half-width of
+        the training ranges, around its own midpoint (see the module docstring).
 
     Attributes (after :meth:`fit`)
     ------------------------------
@@ -42,9 +54,10 @@ class FeatureNormalizer:
         K.
     """
 
-    def __init__(self, a: float = NORMALIZE_A, eps: float = NORMALIZE_EPS):
+    def __init__(self, a: float = NORMALIZE_A, eps: float = NORMALIZE_EPS, scale: str = "component"):
         self.a = a
         self.eps = eps
+        self.scale = scale
 
     # -- fitting -------------------------------------------------------------------------------
     def fit(self, X) -> "FeatureNormalizer":
@@ -56,12 +69,17 @@ class FeatureNormalizer:
             raise ValueError(f"a must lie in (0, 1) so that tanh can reach it, got {self.a}")
         if not float(self.eps) > 0.0:
             raise ValueError(f"eps must be positive, got {self.eps}")
+        if self.scale not in SCALES:
+            raise ValueError(f"scale must be one of {SCALES}, got {self.scale!r}")
         X = self._check_rows(X, fitted=False)
         lo = X.min(axis=0)
         hi = X.max(axis=0)
         constant = hi - lo <= 0.0
         lo = np.where(constant, lo - self.eps, lo)
         hi = np.where(constant, hi + self.eps, hi)
+        if self.scale == "shared":
+            mid, half = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo))
+            lo, hi = mid - half, mid + half
         self.min_ = lo.astype(np.float64)
         self.max_ = hi.astype(np.float64)
         self.n_features_in_ = X.shape[1]
@@ -91,13 +109,14 @@ class FeatureNormalizer:
     def state_dict(self) -> dict:
         """Everything needed to rebuild the fitted normaliser: plain floats and float64 arrays."""
         self._check_fitted()
-        return {"a": float(self.a), "eps": float(self.eps), "min": self.min_.copy(), "max": self.max_.copy()}
+        return {"a": float(self.a), "eps": float(self.eps), "scale": str(self.scale),
+                "min": self.min_.copy(), "max": self.max_.copy()}
 
     @classmethod
     def from_state_dict(cls, state: dict) -> "FeatureNormalizer":
         """Rebuild a fitted normaliser from :meth:`state_dict` output."""
         try:
-            norm = cls(a=float(state["a"]), eps=float(state["eps"]))
+            norm = cls(a=float(state["a"]), eps=float(state["eps"]), scale=str(state.get("scale", "component")))
             lo = np.asarray(state["min"], dtype=np.float64)
             hi = np.asarray(state["max"], dtype=np.float64)
         except (KeyError, TypeError) as exc:
@@ -134,4 +153,5 @@ class FeatureNormalizer:
 
     def __repr__(self) -> str:
         fitted = f", K={self.n_features_in_}" if hasattr(self, "min_") else ""
-        return f"FeatureNormalizer(a={self.a}, eps={self.eps}{fitted})"
+        shared = ", scale='shared'" if self.scale == "shared" else ""
+        return f"FeatureNormalizer(a={self.a}, eps={self.eps}{shared}{fitted})"

@@ -85,6 +85,9 @@ class TrainConfig:
         epochs bring no improvement; then a new network is trained on *all* rows for the best
         number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
     validation_every, patience : see ``early_stopping``.
+    feature_scale : "component" (the paper's Eq. 3) or "shared" (one half-width for all components,
+        see :class:`~meshvae_lib.normalization.FeatureNormalizer`). None: "shared" for coordinate
+        features (``"coords"``, ``"aligned"``) of PCA-initialised networks, "component" otherwise.
     """
 
     epochs: int = DEFAULT_EPOCHS
@@ -104,6 +107,7 @@ class TrainConfig:
     early_stopping: bool | None = None
     validation_every: int = VALIDATION_EVERY
     patience: int = EARLY_STOPPING_PATIENCE
+    feature_scale: str | None = None
 
     def uses_pca_init(self, n_conditions: int = 0) -> bool:
         """True when a new network is built by :func:`pca_network` (see ``init``)."""
@@ -115,6 +119,13 @@ class TrainConfig:
             return float(self.feature_range)
         pca = self.uses_pca_init() if pca is None else pca
         return PCA_FEATURE_RANGE if pca else NORMALIZE_A
+
+    def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
+        """How :class:`~meshvae_lib.checkpoint.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
+        if self.feature_scale is not None:
+            return self.feature_scale
+        pca = self.uses_pca_init() if pca is None else pca
+        return "shared" if pca and kind in ("coords", "aligned") else "component"
 
     def resolved_early_stopping(self, pca: bool | None = None) -> bool:
         if self.early_stopping is not None:
@@ -137,6 +148,7 @@ class TrainConfig:
             "feature_range": self.feature_range is None or 0.0 < float(self.feature_range) < 1.0,
             "validation_every": self.validation_every >= 2,
             "patience": self.patience >= 1,
+            "feature_scale": self.feature_scale in (None, "component", "shared"),
         }
         for name, ok in checks.items():
             if not ok:

@@ -162,7 +162,7 @@ def test_default_model_round_trips_and_is_at_least_as_good_as_its_pca_start(coll
     from meshvae_lib.evaluation import evaluate_model, pca_baseline
 
     model = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40)).fit(collection)
-    assert model.network_.input_rank > 0 and model.normalizer_.a == 0.3
+    assert model.network_.input_rank > 0 and model.normalizer_.a == 0.3 and model.normalizer_.scale == "shared"
     loaded = load_model(model.save(tmp_path / "d.pt"), collection)
     assert loaded.network_.input_rank == model.network_.input_rank
     np.testing.assert_array_equal(loaded.encode_meshes(collection), model.encode_meshes(collection))

@@ -72,3 +72,23 @@ def test_wrong_width_and_unfitted(rng):
         norm.transform(np.zeros((2, 5)))
     with pytest.raises(ValueError, match="a must lie"):
         FeatureNormalizer(a=1.0).fit(np.zeros((2, 2)))
+
+
+def test_shared_scale_keeps_centres_and_gives_every_component_the_largest_width():
+    X = np.array([[0.0, 10.0, 5.0], [1.0, 10.5, 5.0], [4.0, 11.0, 5.0]])
+    nz = FeatureNormalizer(a=0.3, scale="shared").fit(X)
+    np.testing.assert_allclose(nz.max_ - nz.min_, 4.0)  # the widest range, column 0
+    np.testing.assert_allclose(0.5 * (nz.min_ + nz.max_), [2.0, 10.5, 5.0])  # each column's midpoint
+    Y = nz.transform(X)
+    np.testing.assert_allclose(Y[:, 0], [-0.3, -0.15, 0.3])
+    np.testing.assert_allclose(Y[:, 1], [-0.075, 0.0, 0.075])  # a barely moving column stays small
+    np.testing.assert_allclose(Y[:, 2], 0.0)
+    np.testing.assert_allclose(nz.inverse_transform(Y), X, atol=1e-12)
+    # squared errors of normalised rows are proportional to squared errors of the raw rows
+    d = np.array([0.1, -0.2, 0.3])
+    assert np.sum((nz.transform(X[0] + d) - Y[0]) ** 2) == pytest.approx((0.6 / 4.0) ** 2 * np.sum(d ** 2))
+    back = FeatureNormalizer.from_state_dict(nz.state_dict())
+    assert back.scale == "shared" and "shared" in repr(back)
+    np.testing.assert_array_equal(back.transform(X), Y)
+    with pytest.raises(ValueError, match="scale"):
+        FeatureNormalizer(scale="global").fit(X)
