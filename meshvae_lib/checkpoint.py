@@ -28,6 +28,7 @@ import numpy as np
 import torch
 
 from .features import ConditionEncoder, FeatureExtractor
+from .tolerances import FIT_LATENT_STEP
 from .normalization import FeatureNormalizer
 from .training import TrainConfig, holdout_mask, pad_sigma_object, train_vae
 from .vae import MeshVAE
@@ -252,12 +253,81 @@ class MeshVAEModel:
         V = self.extractor_.inverse_transform(self.normalizer_.inverse_transform(rows.double().numpy()))
         return V[0] if single else V
 
-    def reconstruct(self, vertices, conditions=None, labels=None) -> np.ndarray:
-        """Encode to the latent means and decode: meshes (N, n, 3) -> (N, n, 3) float64."""
+    def reconstruct(self, vertices, conditions=None, labels=None, fit_iterations: int = 0) -> np.ndarray:
+        """Encode to the latent means and decode: meshes (N, n, 3) -> (N, n, 3) float64.
+
+        ``fit_iterations > 0``: then refine the codes on the vertex positions (:meth:`fit_latent`).
+        """
         if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
             labels = vertices.labels
-        z = self.encode_meshes(vertices, conditions, labels)
+        if fit_iterations:
+            z = self.fit_latent(vertices, iterations=fit_iterations, conditions=conditions, labels=labels)
+        else:
+            z = self.encode_meshes(vertices, conditions, labels)
         return self.decode_latent(z, conditions, labels)
+
+    def fit_latent(self, vertices, iterations: int = 3, z0=None, conditions=None, labels=None,
+                   step: float = FIT_LATENT_STEP) -> np.ndarray:
+        """Latent codes fitted to vertex positions through the decoder (an option beside the paper's encoder).
+
+        The paper's encoder picks z from the *features*; on real collections the features of a
+        held-out mesh are mostly reproduced in directions that matter little for the vertices
+        (docs/vae.md, issue 12). This minimises instead the decoded mesh's squared vertex error,
+        ``sum_k |decode(z)_k - (R v_k + t)|^2`` over z and the best rigid motion (R, t), by
+        Gauss-Newton from the encoder's means (or ``z0``): each iteration takes the Jacobian of the
+        decoded vertices with respect to the latent dimensions the decoder uses by forward
+        differences (one decode + reconstruction per dimension), solves the linear least-squares
+        step and halves it (up to 3 times) until the error falls. The decoder, normaliser and
+        reconstruction are not changed; this is the same model, encoded by fitting.
+
+        vertices : (N, n, 3) meshes or a collection; iterations : Gauss-Newton steps (>= 1);
+        z0 : (N, D) starting codes; step : finite-difference step in latent units.
+        Returns (N, D) float64 codes. Cost: iterations x (dimensions used + 1) decodes per mesh.
+        """
+        self._check_fitted()
+        if iterations < 1:
+            raise ValueError(f"iterations must be >= 1, got {iterations}")
+        if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
+            labels = vertices.labels
+        V = np.asarray(getattr(vertices, "vertices", vertices), dtype=np.float64)
+        V = V[None] if V.ndim == 2 else V
+        Z = np.array(self.encode_meshes(V, conditions, labels) if z0 is None else z0, dtype=np.float64)
+        if Z.shape != (len(V), self.network_.latent_dim):
+            raise ValueError(f"z0 must have shape ({len(V)}, {self.network_.latent_dim}), got {Z.shape}")
+        C = None
+        if self.is_conditional:
+            C = self._conditions(len(V), conditions, labels).numpy()
+        W = self.network_.decoder_head.weight.detach()
+        used = np.flatnonzero(W[:, : self.network_.latent_dim].abs().sum(0).numpy() > 0) if not self.network_.hidden \
+            else np.arange(self.network_.latent_dim)
+        eye = np.eye(self.network_.latent_dim)[used] * step
+        from .alignment import rigid_align
+
+        for j in range(len(V)):
+            c = None if C is None else C[j]
+            err = None
+            for _ in range(iterations):
+                batch = np.vstack([Z[j][None], Z[j][None] + eye])
+                P = self.decode_latent(batch, conditions=None if c is None else np.broadcast_to(c, (len(batch), len(c))))
+                P0 = P[0]
+                target = rigid_align(V[j], P0)
+                r0 = (target - P0).ravel()
+                err = float(r0 @ r0) if err is None else err
+                J = ((P[1:] - P0).reshape(len(used), -1) / step).T  # (3n, d)
+                dz, *_ = np.linalg.lstsq(J, r0, rcond=None)
+                t = 1.0
+                for _ in range(4):
+                    z_new = Z[j].copy()
+                    z_new[used] += t * dz
+                    Pn = self.decode_latent(z_new, conditions=c)
+                    rn = (rigid_align(V[j], Pn) - Pn).ravel()
+                    if float(rn @ rn) < err:
+                        Z[j], err = z_new, float(rn @ rn)
+                        break
+                    t *= 0.5
+                else:
+                    break  # no step lowered the error: done
+        return Z
 
     def sample_latent(self, n: int, seed: int = 0) -> np.ndarray:
         """n draws from the prior N(0, diag(sigma_object^2)): (n, D) float64."""

@@ -32,13 +32,15 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
     return float(err) if P.ndim == 2 else err
 
 
-def evaluate_model(model, collection, indices=None, held_out_only: bool = False) -> dict:
+def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0) -> dict:
     """Reconstruct meshes of ``collection`` (encode to the latent mean, decode) and measure them.
 
     model : :class:`~meshvae_lib.checkpoint.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
     indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
         collection must then be the one it was trained on).
+    fit_iterations : 0 (default) encodes with the network (the paper); k > 0 fits the latent codes
+        to the vertex positions with k Gauss-Newton steps (``MeshVAEModel.fit_latent``).
 
     Returns a dict: ``mean_vertex_error`` (float, mesh units), ``relative_error`` (mean error /
     bounding-box diagonal of each true mesh, averaged), ``n_meshes``, ``per_mesh`` (list of float),
@@ -62,7 +64,9 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False)
         raise ValueError(f"indices must lie in 0..{len(V) - 1}, got {idx.min()}..{idx.max()}")
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(collection, "labels", {}) or {}).items()}
     sub = V[idx]
-    rec = model.reconstruct(sub, labels=labels if model.is_conditional else None)
+    lab = labels if model.is_conditional else None
+    rec = model.reconstruct(sub, labels=lab, fit_iterations=fit_iterations) if fit_iterations else \
+        model.reconstruct(sub, labels=lab)
     err = per_vertex_error(rec, sub)
     diag = np.atleast_1d(bounding_box_diagonal(sub))
     names = list(getattr(collection, "names", []) or [])
@@ -74,6 +78,7 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False)
         "names": [names[i] for i in idx] if names else [str(i) for i in idx],
         "indices": [int(i) for i in idx],
         "features": model.extractor_.kind,
+        "fit_iterations": int(fit_iterations),
     }
 
 

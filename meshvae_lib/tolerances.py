@@ -137,6 +137,9 @@ PCA_FEATURE_RANGE = 0.3
 VALIDATION_EVERY = 8
 #: early stopping: stop choosing after this many epochs without a lower validation error.
 EARLY_STOPPING_PATIENCE = 100
+#: MeshVAEModel.fit_latent: forward-difference step in latent units (the PCA-started latent
+#: dimensions have unit spread over the training meshes).
+FIT_LATENT_STEP = 1e-2
 #: PCA initialisation: principal directions with singular value below this fraction of the
 #: largest are not used.
 PCA_INIT_RTOL = 1e-8

@@ -173,3 +173,26 @@ def test_default_model_round_trips_and_is_at_least_as_good_as_its_pca_start(coll
     err = evaluate_model(m, collection, held_out_only=True)["mean_vertex_error"]
     floor = pca_baseline(collection.vertices[~mask], collection.vertices[mask], aligned=True)["mean_vertex_error"]
     assert err < 1.5 * floor + 1e-3
+
+
+def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
+    from meshvae_lib.evaluation import evaluate_model, per_vertex_error
+
+    model = MeshVAEModel("rimd", TrainConfig(progress=False, epochs=20, latent_dim=8), holdout_every=4).fit(collection)
+    held = np.flatnonzero(model.holdout_mask_)
+    V = collection.vertices[held]
+    z_enc = model.encode_meshes(V)
+    z_fit = model.fit_latent(V, iterations=2)
+    assert z_fit.shape == z_enc.shape
+    e_enc = per_vertex_error(model.decode_latent(z_enc), V)
+    e_fit = per_vertex_error(model.decode_latent(z_fit), V)
+    assert np.all(e_fit <= e_enc + 1e-12) and np.mean(e_fit) < np.mean(e_enc)
+    # only the latent dimensions the decoder uses move
+    used = model.network_.decoder_head.weight.detach().abs().sum(0).numpy() > 0
+    np.testing.assert_array_equal(z_fit[:, ~used], z_enc[:, ~used])
+    res = evaluate_model(model, collection, held_out_only=True, fit_iterations=2)
+    assert res["fit_iterations"] == 2 and res["mean_vertex_error"] == pytest.approx(np.mean(e_fit), rel=1e-9)
+    with pytest.raises(ValueError, match="iterations"):
+        model.fit_latent(V, iterations=0)
+    with pytest.raises(ValueError, match="z0"):
+        model.fit_latent(V, z0=np.zeros((1, 8)))

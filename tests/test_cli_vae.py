@@ -154,3 +154,14 @@ def test_evaluate_reports_the_pca_baseline(data, capsys):
     other = write_collection(root / "few.npz", MeshCollection(coll.vertices[:5], coll.faces))
     assert main(["evaluate", str(model), str(other), "--pca"]) == 1
     assert "--pca TRAIN" in capsys.readouterr().err
+
+
+def test_evaluate_with_codes_fitted_to_the_vertices(data, capsys):
+    root, path, model, coll = data
+    capsys.readouterr()
+    assert main(["evaluate", str(model), str(path), "--held-out", "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)["mean_vertex_error"]
+    assert main(["evaluate", str(model), str(path), "--held-out", "--fit-latent", "2", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["fit_iterations"] == 2 and res["mean_vertex_error"] <= plain + 1e-12
+    assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 1
