@@ -454,8 +454,8 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
                              None if red_a is None else f"{100 * red_a:.0f}%"] + pcells)
     table.data["kinds"] = list(kinds)
     table.notes.append("Paper: RIMD reduces the error by 59-94% against 3D coordinates and 27-72% against aligned"
-                       " coordinates. Here the three inputs share the training budget; the coordinate baselines get"
-                       " the hidden layer that did best for them (training.default_hidden), RIMD none.")
+                       " coordinates. Here the three inputs share the training budget and the library defaults (PCA start,"
+                       " early stopping, no hidden layer: training.default_hidden; docs/vae.md, issue 12).")
     return table
 
 
