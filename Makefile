@@ -7,27 +7,45 @@ STAMP := $(VENV)/.installed
 BUILD := build
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 SANITIZE := notebooks/nbval_sanitize.cfg
-PYTEST_NB := --nbval --nbval-current-env --nbval-sanitize-with $(SANITIZE) --nbval-cell-timeout=600
+PYTEST_NB := --nbval --nbval-current-env --nbval-sanitize-with $(SANITIZE) --nbval-cell-timeout=900
+LOCK := constraints.txt
+# Float settings under which `make test-portable` re-runs every notebook against its stored outputs.
+# Each changes the digits that come out of training (measured: README, "What nbval checks"):
+# torch's generic (non-AVX) kernels on one thread, and MKL's reproducible "compatible" code path.
+PORTABLE_SETTINGS := "ATEN_CPU_CAPABILITY=default MESHVAE_NUM_THREADS=1" "MKL_CBWR=COMPATIBLE"
 
-.PHONY: venv lab test test-fast browser notebooks course student experiments bench clean help
+.PHONY: venv lock lab test test-fast test-portable browser notebooks course student experiments bench clean help
 
 help:
 	@echo "make lab          set up .venv and open JupyterLab on notebooks/"
 	@echo "make test         set up .venv (and Chromium where possible) and run every test and notebook"
 	@echo "make test-fast    unit tests only (no notebooks, no browser)"
+	@echo "make test-portable  re-run every notebook under changed float settings against its stored outputs"
+	@echo "make lock         re-resolve the packages and rewrite $(LOCK) (then re-run make notebooks and make test)"
 	@echo "make notebooks    re-execute every notebook in place (refreshes the stored outputs)"
 	@echo "make course       execute all notebooks and write an HTML course to $(BUILD)/course"
 	@echo "make student      write student copies without solutions to $(BUILD)/student"
 	@echo "make experiments  run the paper's experiments at full size into $(BUILD)/experiments"
 	@echo "make bench        run the benchmarks in benchmarks/"
 
-# The virtual environment is rebuilt whenever pyproject.toml changes.
-$(STAMP): pyproject.toml
+# The virtual environment is rebuilt whenever pyproject.toml or the lock changes; the lock pins
+# every package to the version the notebooks were recorded with.
+$(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e ".[dev]"
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -c $(LOCK) -e ".[dev]"
 	@touch $(STAMP)
 
 venv: $(STAMP)
+
+# Resolve pyproject.toml afresh in a throw-away venv and write every installed version to the lock.
+lock:
+	rm -rf $(BUILD)/lock-venv
+	$(PYTHON) -m venv $(BUILD)/lock-venv
+	$(BUILD)/lock-venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[dev]"
+	{ sed -n '/^#/p;/^#/!q' $(LOCK); $(BUILD)/lock-venv/bin/python -m pip freeze --exclude-editable | sed 's/+cpu$$//'; } > $(LOCK).new
+	mv $(LOCK).new $(LOCK)
+	rm -rf $(BUILD)/lock-venv
+	@echo "wrote $(LOCK); now update environment.yml's pins, then make notebooks && make test"
 
 # Headless Chromium for the real-browser test (Debian's package; never `playwright install`).
 browser:
@@ -39,6 +57,13 @@ lab: $(STAMP)
 
 test: $(STAMP) browser
 	$(BIN)/python -m pytest tests notebooks $(PYTEST_NB)
+
+# The stored outputs must hold under other float summation orders, as on another machine.
+test-portable: $(STAMP)
+	@for s in $(PORTABLE_SETTINGS); do \
+	  echo "== notebooks under $$s"; \
+	  env $$s $(BIN)/python -m pytest notebooks $(PYTEST_NB) -p no:cacheprovider -q || exit 1; \
+	done
 
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest tests -m "not browser and not slow"

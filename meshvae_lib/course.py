@@ -99,8 +99,43 @@ def student_notebook(nb):
     return out
 
 
+def inject_parameters(nb, parameters: dict[str, str]):
+    """Insert a cell that overrides parameters right after the notebook's ``parameters`` cell.
+
+    As papermill does: the new cell (tagged ``injected-parameters``) assigns each value, so the
+    lesson runs with, say, another seed without editing it. Values derived inside the parameters
+    cell itself (``RESOLUTION = None if FULL else 600``) are not recomputed.
+
+    Parameters
+    ----------
+    nb : nbformat.NotebookNode
+        The notebook (changed in place and returned).
+    parameters : dict of str to str
+        Parameter name to a Python expression, e.g. ``{"SEED": "1"}``.
+
+    Raises
+    ------
+    ValueError
+        When the notebook has no ``parameters`` cell, or a name is not assigned in it.
+    """
+    import nbformat
+
+    index = next((i for i, c in enumerate(nb.cells)
+                  if c.cell_type == "code" and "parameters" in c.metadata.get("tags", [])), None)
+    if index is None:
+        raise ValueError("the notebook has no cell tagged 'parameters'")
+    source = nb.cells[index].source
+    for name in parameters:
+        if not re.search(rf"^{re.escape(name)}\s*=", source, flags=re.MULTILINE):
+            raise ValueError(f"parameter {name!r} is not assigned in the parameters cell:\n{source}")
+    cell = nbformat.v4.new_code_cell("# Injected parameters\n" + "".join(f"{k} = {v}\n" for k, v in parameters.items()))
+    cell.metadata["tags"] = ["injected-parameters"]
+    nb.cells.insert(index + 1, cell)
+    return nb
+
+
 def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3",
-                     store_widget_state: bool = False):
+                     store_widget_state: bool = False, parameters: dict[str, str] | None = None):
     """Execute a notebook on a fresh kernel, in its own folder, and return it.
 
     Parameters
@@ -115,11 +150,15 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         Store the widgets' state in the notebook. Off by default: the 3D views' state holds
         every vertex buffer (megabytes) and an HTML export of it needs the three.js widget code
         from a CDN; without it each view exports as the PNG snapshot the viewer stores beside it.
+    parameters : dict of str to str, optional
+        Overrides of the parameters cell (see :func:`inject_parameters`).
     """
     import nbformat
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
+    if parameters:
+        inject_parameters(nb, parameters)
     for cell in nb.cells:  # timestamps of an earlier run would only churn the committed file
         cell.metadata.pop("execution", None)
     client = NotebookClient(
@@ -131,7 +170,37 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         record_timing=False,
     )
     client.execute()
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            cell.outputs = coalesce_streams(cell.outputs)
     return nb
+
+
+def coalesce_streams(outputs: list) -> list:
+    """Merge consecutive stream outputs of the same stream (stdout or stderr) into one.
+
+    How a kernel splits a cell's printing into messages depends on timing; merged, the stored
+    outputs of a deterministic cell are the same on every run (nbval compares the merged text too).
+
+    Parameters
+    ----------
+    outputs : list of nbformat output nodes
+        A code cell's outputs.
+
+    Returns
+    -------
+    list
+        The same outputs, with each run of same-stream ``stream`` outputs joined into the first.
+    """
+    merged: list = []
+    for out in outputs:
+        prev = merged[-1] if merged else None
+        if (out.get("output_type") == "stream" and prev is not None and prev.get("output_type") == "stream"
+                and prev.get("name") == out.get("name")):
+            prev["text"] = prev["text"] + out["text"]
+        else:
+            merged.append(out)
+    return merged
 
 
 def _notebook_paths(paths: list[str]) -> list[Path]:
@@ -149,12 +218,29 @@ def _notebook_paths(paths: list[str]) -> list[Path]:
 def _cmd_execute(args) -> int:
     import nbformat
 
+    parameters = _parameters(args.set)
+    if parameters and not args.out:
+        raise ValueError("--set changes the lesson: give --out DIR so the stored notebooks are not overwritten")
+    out = Path(args.out) if args.out else None
+    if out:
+        out.mkdir(parents=True, exist_ok=True)
     for path in _notebook_paths(args.notebooks):
         start = time.perf_counter()
-        nb = execute_notebook(path, timeout=args.timeout)
-        nbformat.write(nb, path)
-        print(f"executed {path} in {time.perf_counter() - start:.1f} s")
+        nb = execute_notebook(path, timeout=args.timeout, parameters=parameters)
+        target = out / path.name if out else path
+        nbformat.write(nb, target)
+        print(f"executed {path} -> {target} in {time.perf_counter() - start:.1f} s")
     return 0
+
+
+def _parameters(assignments: list[str] | None) -> dict[str, str]:
+    result = {}
+    for text in assignments or []:
+        name, sep, value = text.partition("=")
+        if not sep or not name.strip().isidentifier() or not value.strip():
+            raise ValueError(f"--set expects NAME=VALUE, got {text!r}")
+        result[name.strip()] = value.strip()
+    return result
 
 
 def _cmd_html(args) -> int:
@@ -212,6 +298,9 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("execute", help="execute notebooks in place (refreshes their stored outputs)")
     p.add_argument("notebooks", nargs="+")
     p.add_argument("--timeout", type=int, default=600, help="seconds per cell (default 600)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="override a parameter of the parameters cell (repeatable), e.g. --set SEED=1; needs --out")
+    p.add_argument("--out", metavar="DIR", help="write the executed notebooks here instead of in place")
     p.set_defaults(func=_cmd_execute)
     p = sub.add_parser("html", help="execute notebooks and write an HTML course with an index")
     p.add_argument("notebooks", nargs="+")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import nbformat
 import pytest
 
-from meshvae_lib.course import STUDENT_PLACEHOLDER, main, strip_solutions, student_notebook
+from meshvae_lib.course import (STUDENT_PLACEHOLDER, coalesce_streams, inject_parameters, main, strip_solutions,
+                                 student_notebook)
 
 
 def test_strip_solutions_replaces_block_and_keeps_the_rest():
@@ -85,3 +86,42 @@ def test_execute_html_and_student_commands(tmp_path, capsys):
 def test_missing_notebook_is_a_clear_error(tmp_path, capsys):
     assert main(["student", "--out", str(tmp_path), str(tmp_path / "nope.ipynb")]) == 1
     assert "no notebook at" in capsys.readouterr().err
+
+
+def _stream(name, text):
+    return nbformat.v4.new_output("stream", name=name, text=text)
+
+
+def test_coalesce_streams_merges_runs_of_one_stream_only():
+    outs = [_stream("stdout", "a\n"), _stream("stdout", "b\n"), _stream("stderr", "w\n"), _stream("stdout", "c\n"),
+            nbformat.v4.new_output("execute_result", data={"text/plain": "1"}, execution_count=1),
+            _stream("stdout", "d\n")]
+    merged = coalesce_streams(outs)
+    assert [(o.output_type, o.get("name"), o.get("text")) for o in merged] == [
+        ("stream", "stdout", "a\nb\n"), ("stream", "stderr", "w\n"), ("stream", "stdout", "c\n"),
+        ("execute_result", None, None), ("stream", "stdout", "d\n")]
+    assert coalesce_streams([]) == []
+
+
+def test_inject_parameters_goes_right_after_the_parameters_cell():
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell("# L"), nbformat.v4.new_code_cell("# Parameters\nSEED = 0\nN = 3\n"),
+                nbformat.v4.new_code_cell("print(SEED)")]
+    nb.cells[1].metadata["tags"] = ["parameters"]
+    inject_parameters(nb, {"SEED": "7"})
+    assert [c.source for c in nb.cells][1:3] == ["# Parameters\nSEED = 0\nN = 3\n", "# Injected parameters\nSEED = 7\n"]
+    assert nb.cells[2].metadata["tags"] == ["injected-parameters"]
+    with pytest.raises(ValueError, match="'LR' is not assigned"):
+        inject_parameters(nb, {"LR": "1"})
+    nb.cells[1].metadata["tags"] = []
+    with pytest.raises(ValueError, match="no cell tagged 'parameters'"):
+        inject_parameters(nb, {"SEED": "1"})
+
+
+def test_execute_with_set_needs_out_and_a_valid_assignment(tmp_path, capsys):
+    path = tmp_path / "00_tiny.ipynb"
+    nbformat.write(_tiny_notebook(), path)
+    assert main(["execute", str(path), "--set", "A=1"]) == 1
+    assert "--out" in capsys.readouterr().err
+    assert main(["execute", str(path), "--set", "no equals", "--out", str(tmp_path / "o")]) == 1
+    assert "NAME=VALUE" in capsys.readouterr().err

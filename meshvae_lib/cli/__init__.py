@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 
 #: sub-commands, in the order ``meshvae --help`` lists them.
@@ -52,7 +53,11 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from ..model.threads import ENV_VAR, configure_threads
+
     try:
+        if os.environ.get(ENV_VAR, "").strip():  # only then, so that commands without torch stay fast
+            configure_threads()
         return int(args.func(args) or 0)
     except (ValueError, FileNotFoundError, OSError) as exc:
         # Errors from bad input are the user's to fix: one clear line, no traceback.
