@@ -12,9 +12,10 @@ the paper's encoder). Two linear rows close each table: PCA on coordinates and o
 fitted on the training meshes with every direction they span (``evaluation.pca_baseline``).
 
 Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
-repository) when that folder exists, else a ``data_synth`` collection. ``--legacy`` trains with the
-defaults before issue 12 (random initialisation, all epochs, a = 0.9, a hidden layer of 256 for the
-coordinate kinds) to show the difference.
+repository) when that folder exists, else a ``data_synth`` collection. By default it trains with the
+PCA start of issue 12 (``TrainConfig(init="pca")``: an option, not the library's default yet, see
+docs/vae.md); ``--legacy`` trains the paper's way, the library's default (random initialisation,
+all epochs, a = 0.9, a hidden layer of 256 for the coordinate kinds), to show the difference.
 
     python benchmarks/feature_comparison.py                              # real collections if present
     python benchmarks/feature_comparison.py --real pcow --subsample 3    # every 3rd frame of pcow
@@ -57,7 +58,7 @@ def config_for(kind: str, legacy: bool, seed: int, epochs: int | None) -> TrainC
         hidden = () if kind == "rimd" else (256,)
         return TrainConfig(hidden=hidden, init="random", early_stopping=False, feature_range=0.9, seed=seed,
                            progress=False, device="cpu", **extra)
-    return TrainConfig(seed=seed, progress=False, device="cpu", **extra)
+    return TrainConfig(seed=seed, progress=False, device="cpu", init="pca", **extra)
 
 
 def run_collection(coll, name: str, args) -> list[dict]:
@@ -65,7 +66,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
     mask = holdout_mask(len(V), args.holdout_every)
     diag = float(np.mean(np.linalg.norm(np.ptp(V, axis=1), axis=1)))
     print(f"\n{name}: {len(V)} meshes ({int((~mask).sum())} train / {int(mask.sum())} held out), {V.shape[1]} vertices,"
-          f" mean bounding-box diagonal {diag:.4g}; {'legacy' if args.legacy else 'library'} defaults,"
+          f" mean bounding-box diagonal {diag:.4g}; {'paper (library default)' if args.legacy else 'PCA-start'} training,"
           f" {torch.get_num_threads()} thread(s)", flush=True)
     print(f"{'features':18s} {'K':>7s} {'train error':>12s} {'held-out':>10s} {'% diag':>7s} {'epochs':>6s} {'time (s)':>9s}",
           flush=True)
@@ -130,7 +131,7 @@ def main() -> None:
     ap.add_argument("--holdout-every", type=int, default=5)
     ap.add_argument("--kinds", default=",".join(KINDS))
     ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
-    ap.add_argument("--legacy", action="store_true", help="the training defaults before issue 12")
+    ap.add_argument("--legacy", action="store_true", help="the paper's training (the library default) instead of the PCA start")
     ap.add_argument("--fit-latent", type=int, default=0, metavar="N",
                     help="also evaluate with latent codes fitted to the held-out vertices (N Gauss-Newton steps)")
     ap.add_argument("--seed", type=int, default=0)

@@ -32,14 +32,19 @@ INIT_MODES = ("pca", "random")
 logger = logging.getLogger(__name__)
 
 
-def default_hidden(kind: str = "rimd") -> tuple[int, ...]:
+def default_hidden(kind: str = "rimd", init: str = "random") -> tuple[int, ...]:
     """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
 
-    None for every kind: with the PCA initialisation (``TrainConfig.init``) a network without
-    internal layers starts at the linear floor, and on the real collections nothing trained from a
-    random start came near it (docs/vae.md, issue 12). Coordinate baselines: HIDDEN_COORDS.
+    With the paper's random initialisation: none for RIMD, HIDDEN_COORDS for the coordinate
+    baselines. With the PCA initialisation (``init="pca"``, see ``TrainConfig.init``): none for
+    every kind, since a network without internal layers then starts at the linear floor, and on the
+    real collections nothing trained from a random start came near it (docs/vae.md, issue 12).
     """
-    if kind == "rimd":
+    if init not in INIT_MODES:
+        raise ValueError(f"unknown init {init!r}; expected one of {INIT_MODES}")
+    if kind not in ("rimd", "coords", "aligned"):
+        raise ValueError(f"unknown feature kind {kind!r}")
+    if kind == "rimd" or init == "pca":
         return ()
     if kind in ("coords", "aligned"):
         return tuple(HIDDEN_COORDS)
@@ -67,7 +72,9 @@ class TrainConfig:
     progress : show a tqdm progress bar (terminal or notebook).
     eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
         how often early stopping looks at its validation meshes.
-    init : "pca" (default) or "random". "pca": an unconditional network without internal layers
+    init : "random" (default: PyTorch's initialisation, the paper's network) or "pca" (an option,
+        issue 12; not yet the default because the course's lessons train from a random start).
+        "pca": an unconditional network without internal layers
         and with the standard prior (``hidden=()``, ``sigma_object=None``) is built by
         :func:`pca_network`:
         its encoder sees the whitened principal coefficients of the training features and its
@@ -102,7 +109,7 @@ class TrainConfig:
     device: str = "auto"
     progress: bool = True
     eval_every: int = 10
-    init: str = "pca"
+    init: str = "random"
     feature_range: float | None = None
     early_stopping: bool | None = None
     validation_every: int = VALIDATION_EVERY

@@ -158,17 +158,17 @@ def test_conditioning_changes_what_is_generated(collection, tmp_path):
         model.encode_meshes(collection.vertices)
 
 
-def test_default_model_round_trips_and_is_at_least_as_good_as_its_pca_start(collection, tmp_path):
+def test_pca_started_model_round_trips_and_is_at_least_as_good_as_its_pca_start(collection, tmp_path):
     from meshvae_lib.evaluation import evaluate_model, pca_baseline
 
-    model = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40)).fit(collection)
+    model = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40, init="pca")).fit(collection)
     assert model.network_.input_rank > 0 and model.normalizer_.a == 0.3 and model.normalizer_.scale == "shared"
     loaded = load_model(model.save(tmp_path / "d.pt"), collection)
     assert loaded.network_.input_rank == model.network_.input_rank
     np.testing.assert_array_equal(loaded.encode_meshes(collection), model.encode_meshes(collection))
     np.testing.assert_array_equal(loaded.reconstruct(collection.vertices[:3]), model.reconstruct(collection.vertices[:3]))
     # held-out: close to linear PCA on aligned coordinates (the model starts there)
-    m = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40), holdout_every=4).fit(collection)
+    m = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40, init="pca"), holdout_every=4).fit(collection)
     mask = m.holdout_mask_
     err = evaluate_model(m, collection, held_out_only=True)["mean_vertex_error"]
     floor = pca_baseline(collection.vertices[~mask], collection.vertices[mask], aligned=True)["mean_vertex_error"]

@@ -95,7 +95,8 @@ def test_state_dict_round_trip(kind):
 
 def test_default_hidden_layers():
     assert default_hidden("rimd") == ()
-    assert default_hidden("coords") == tuple(HIDDEN_COORDS) == default_hidden("aligned")
+    assert default_hidden("coords") == tuple(HIDDEN_COORDS) == default_hidden("aligned") == (256,)
+    assert default_hidden("coords", "pca") == () == default_hidden("rimd", "pca")
     with pytest.raises(ValueError):
         default_hidden("nope")
 

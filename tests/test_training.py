@@ -184,9 +184,10 @@ def test_pca_network_starts_at_the_pca_reconstruction():
         MeshVAE(10, 4, input_rank=11)
 
 
-def test_defaults_choose_the_epochs_by_early_stopping_on_training_rows():
+def test_pca_start_chooses_the_epochs_by_early_stopping_on_training_rows():
     X = _in_range(n=40)
-    cfg = TrainConfig(epochs=50, latent_dim=8, progress=False, eval_every=5, patience=20)
+    assert not TrainConfig().uses_pca_init() and not TrainConfig().resolved_early_stopping()  # the paper's default
+    cfg = TrainConfig(epochs=50, latent_dim=8, progress=False, eval_every=5, patience=20, init="pca")
     assert cfg.uses_pca_init() and cfg.resolved_early_stopping() and cfg.resolved_feature_range() == 0.3
     res = train_vae(X, config=cfg, val_features=X[:2])
     sel = res.selection
@@ -209,7 +210,7 @@ def test_defaults_choose_the_epochs_by_early_stopping_on_training_rows():
 
 def test_zero_chosen_epochs_returns_the_initialisation_with_an_epoch_0_record():
     X = _in_range(n=24)
-    cfg = TrainConfig(epochs=30, latent_dim=6, progress=False, lr=1.0, eval_every=5, patience=10)  # lr 1: ruins it
+    cfg = TrainConfig(epochs=30, latent_dim=6, progress=False, lr=1.0, eval_every=5, patience=10, init="pca")  # lr 1: ruins it
     res = train_vae(X, config=cfg)
     assert res.epochs == 0 and len(res.history) == 1 and res.history[0]["epoch"] == 0
     init = pca_network(torch.from_numpy(X.astype(np.float32)), cfg)

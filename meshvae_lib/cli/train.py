@@ -51,8 +51,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--epochs", type=int, default=None, metavar="E",
                    help=f"training epochs, the most early stopping may choose (default {d.epochs})")
     p.add_argument("--init", choices=("pca", "random"), default=d.init,
-                   help="pca (default): start from the PCA of the training features (networks without internal"
-                        " layers, standard prior, no labels); random: PyTorch's initialisation (the paper)")
+                   help="pca: start from the PCA of the training features (an option, docs/vae.md; networks without internal"
+                        " layers, standard prior, no labels); random (default): PyTorch's initialisation (the paper)")
     p.add_argument("--no-early-stopping", action="store_true",
                    help="train all --epochs instead of choosing them on every 8th training mesh")
     p.add_argument("--alpha", type=float, default=DEFAULT_ALPHA, metavar="A",
@@ -92,7 +92,7 @@ def run(args) -> int:
         raise ValueError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent}")
     d = TrainConfig()
     epochs = args.epochs if args.epochs is not None else d.epochs
-    hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features)
+    hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
     config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
                          latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
                          prior_form=args.prior_form, seed=args.seed, init=args.init,
