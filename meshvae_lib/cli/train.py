@@ -14,9 +14,10 @@ Train a mesh VAE (Tan et al., CVPR 2018) on a collection of meshes that share on
 and write everything needed to use it (weights, normaliser, reference mesh, faces, labels) to one
 checkpoint file. DATA is an .npz collection or a folder of OBJ/PLY/OFF files (+ labels.csv).
 The defaults train a good model for 50-200 meshes; a progress bar shows the epochs.
-By default the network (no internal layers, standard prior, unconditional) starts as the PCA of
-the training features and early stopping on every 8th training mesh chooses how many of the
---epochs to train (possibly none); see docs/vae.md for why.
+By default it trains as the paper does (random start, all --epochs). With --init pca a network
+without internal layers, with the standard prior and no labels starts as the PCA of the training
+features and early stopping on every 8th training mesh chooses how many of the --epochs to train
+(possibly none); see docs/vae.md, "Generalisation on real meshes".
 
 examples:
   meshvae train scape.npz -o scape.pt
@@ -98,8 +99,9 @@ def run(args) -> int:
                          prior_form=args.prior_form, seed=args.seed, init=args.init,
                          early_stopping=False if args.no_early_stopping else None,
                          device=args.device, progress=not args.no_progress)
+    at_most = "at most " if config.resolved_early_stopping(config.uses_pca_init(len(args.labels))) else ""
     print(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
-          f" latent {args.latent}, hidden {list(hidden)}, at most {epochs} epochs")
+          f" latent {args.latent}, hidden {list(hidden)}, {at_most}{epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference).fit(collection)
     model.save(args.output)
