@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .alignment import bounding_box_diagonal, rigid_align
+from .tolerances import PCA_RANK_RTOL
 
 __all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline"]
 
@@ -65,6 +66,7 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(collection, "labels", {}) or {}).items()}
     sub = V[idx]
     lab = labels if model.is_conditional else None
+    # only pass fit_iterations when asked: a model-like object need not know the option
     rec = model.reconstruct(sub, labels=lab, fit_iterations=fit_iterations) if fit_iterations else \
         model.reconstruct(sub, labels=lab)
     err = per_vertex_error(rec, sub)
@@ -133,7 +135,7 @@ class CoordinatePCA:
         X = self._rows(V)
         self.mean_ = X.mean(axis=0)
         _, s, Vt = np.linalg.svd(X - self.mean_, full_matrices=False)
-        rank = int(np.sum(s > s[0] * 1e-12)) if s.size and s[0] > 0 else 0
+        rank = int(np.sum(s > s[0] * PCA_RANK_RTOL)) if s.size and s[0] > 0 else 0
         k = rank if self.n_components is None else int(self.n_components)
         if not 0 <= k <= min(rank, len(V) - 1) and self.n_components is not None:
             raise ValueError(f"n_components must lie in 0..{min(rank, len(V) - 1)} for these {len(V)} meshes, got {k}")

@@ -143,6 +143,9 @@ FIT_LATENT_STEP = 1e-2
 #: PCA initialisation: principal directions with singular value below this fraction of the
 #: largest are not used.
 PCA_INIT_RTOL = 1e-8
+#: coordinate PCA baseline (evaluation.CoordinatePCA): singular values below this fraction of the
+#: largest count as zero when the span of the training meshes is measured.
+PCA_RANK_RTOL = 1e-12
 
 # --- viewing (meshvae_lib.viewing) -----------------------------------------------------------
 #: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)

@@ -46,9 +46,7 @@ def default_hidden(kind: str = "rimd", init: str = "random") -> tuple[int, ...]:
         raise ValueError(f"unknown feature kind {kind!r}")
     if kind == "rimd" or init == "pca":
         return ()
-    if kind in ("coords", "aligned"):
-        return tuple(HIDDEN_COORDS)
-    raise ValueError(f"unknown feature kind {kind!r}")
+    return tuple(HIDDEN_COORDS)
 
 
 @dataclass
@@ -392,9 +390,10 @@ def train_vae(
     ----------
     features : (N, K) float, normalised (Eq. 3), N >= 2.
     conditions : (N, C) float or None (conditional mesh VAE, Eq. 5).
-    config : TrainConfig (defaults when None): with the defaults a network without internal layers
-        is PCA-initialised (:func:`pca_network`) and the number of epochs is chosen by early
-        stopping on every ``validation_every``-th training row (see :class:`TrainConfig`).
+    config : TrainConfig (defaults when None: the paper's random start, all ``epochs``). With
+        ``init="pca"`` a network without internal layers is PCA-initialised (:func:`pca_network`)
+        and the number of epochs is chosen by early stopping on every ``validation_every``-th
+        training row (see :class:`TrainConfig`).
     val_features, val_conditions : (M, K), (M, C) held-out rows, optional: only recorded in the
         history (``val_*``), never used to choose anything.
     model : continue training this network instead of building a new one (no PCA initialisation
@@ -437,11 +436,11 @@ def train_vae(
     t0 = time.perf_counter()
     epochs, selection = config.epochs, None
     if early:
-        vmask = np.zeros(n, dtype=bool)
-        vmask[config.validation_every - 1 :: config.validation_every] = True
+        vmask = holdout_mask(n, config.validation_every)
         fit_i, val_i = torch.from_numpy(np.flatnonzero(~vmask)), torch.from_numpy(np.flatnonzero(vmask))
-        probe = _new_network(x[fit_i], n_cond, config, pca).to(device)
-        sel_history, epochs = _run(probe, x[fit_i].to(device), None if c is None else c[fit_i].to(device), config,
+        x_fit = x[fit_i]
+        probe = _new_network(x_fit, n_cond, config, pca).to(device)
+        sel_history, epochs = _run(probe, x_fit.to(device), None if c is None else c[fit_i].to(device), config,
                                    config.epochs, device, x[val_i].to(device),
                                    None if c is None else c[val_i].to(device), so_t, select=True,
                                    desc="choosing epochs")

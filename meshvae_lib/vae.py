@@ -10,7 +10,7 @@ decoder one linear map D -> K, so there are no internal layers.
 Input projection (``input_rank = r > 0``, a departure from the paper, issue 12): the encoder does
 not see the K features themselves but their r whitened principal coefficients
 ``(x - input_mean) @ input_basis.T``, a fixed linear map onto the span of the training features
-(set by :func:`meshvae_lib.training.train_vae`, stored in the checkpoint as buffers). On real
+(set by :func:`meshvae_lib.training.pca_network`, stored in the checkpoint as buffers). On real
 collections 4-35% of a held-out mesh's (centred) feature energy lies outside the span of the
 training meshes; a K-wide encoder trained with Adam gives those directions arbitrary weights
 (Adam's per-weight steps leave the span), and held-out meshes get arbitrary latent codes.

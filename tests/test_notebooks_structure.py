@@ -96,7 +96,7 @@ def test_threads_go_through_the_library(nb):
     """`MESHVAE_NUM_THREADS` must reach every notebook (the portability pass relies on it)."""
     code = "\n".join(_text(c) for c in nb.cells if c.cell_type == "code")
     assert "set_num_threads" not in code, "call meshvae_lib.model.threads.configure_threads instead"
-    if "import torch" in code or "meshvae_lib" in code and ("train" in code or "fit(" in code):
+    if "import torch" in code or ("meshvae_lib" in code and ("train" in code or "fit(" in code)):
         assert "configure_threads(" in code
 
 

@@ -38,7 +38,7 @@ def _floats(text: str) -> list[float]:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from ..training import TrainConfig
+    from ..training import INIT_MODES, TrainConfig
 
     d = TrainConfig()
     p = subparsers.add_parser("train", help="train a mesh VAE and save a checkpoint", description=DESCRIPTION,
@@ -51,7 +51,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
                    help=f"training epochs, the most early stopping may choose (default {d.epochs})")
-    p.add_argument("--init", choices=("pca", "random"), default=d.init,
+    p.add_argument("--init", choices=INIT_MODES, default=d.init,
                    help="pca: start from the PCA of the training features (an option, docs/vae.md; networks without internal"
                         " layers, standard prior, no labels); random (default): PyTorch's initialisation (the paper)")
     p.add_argument("--no-early-stopping", action="store_true",
