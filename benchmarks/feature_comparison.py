@@ -13,9 +13,9 @@ fitted on the training meshes with every direction they span (``evaluation.pca_b
 
 Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
 repository) when that folder exists, else a ``data_synth`` collection. By default it trains with the
-PCA start of issue 12 (``TrainConfig(init="pca")``: an option, not the library's default yet, see
-docs/vae.md); ``--legacy`` trains the paper's way, the library's default (random initialisation,
-all epochs, a = 0.9, a hidden layer of 256 for the coordinate kinds), to show the difference.
+library's defaults (the PCA start of issue 12, ``TrainConfig(init="pca")``, see docs/vae.md);
+``--legacy`` trains the paper's way (random initialisation, all epochs, a = 0.9, a hidden layer of
+256 for the coordinate kinds), to show the difference.
 
     python benchmarks/feature_comparison.py                              # real collections if present
     python benchmarks/feature_comparison.py --real pcow --subsample 3    # every 3rd frame of pcow
@@ -66,7 +66,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
     mask = holdout_mask(len(V), args.holdout_every)
     diag = float(np.mean(np.linalg.norm(np.ptp(V, axis=1), axis=1)))
     print(f"\n{name}: {len(V)} meshes ({int((~mask).sum())} train / {int(mask.sum())} held out), {V.shape[1]} vertices,"
-          f" mean bounding-box diagonal {diag:.4g}; {'paper (library default)' if args.legacy else 'PCA-start'} training,"
+          f" mean bounding-box diagonal {diag:.4g}; {'the paper' if args.legacy else 'library default (PCA start)'} training,"
           f" {torch.get_num_threads()} thread(s)", flush=True)
     print(f"{'features':18s} {'K':>7s} {'train error':>12s} {'held-out':>10s} {'% diag':>7s} {'epochs':>6s} {'time (s)':>9s}",
           flush=True)
@@ -131,7 +131,7 @@ def main() -> None:
     ap.add_argument("--holdout-every", type=int, default=5)
     ap.add_argument("--kinds", default=",".join(KINDS))
     ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
-    ap.add_argument("--legacy", action="store_true", help="the paper's training (the library default) instead of the PCA start")
+    ap.add_argument("--legacy", action="store_true", help="the paper's training instead of the library's default (the PCA start)")
     ap.add_argument("--fit-latent", type=int, default=0, metavar="N",
                     help="also evaluate with latent codes fitted to the held-out vertices (N Gauss-Newton steps)")
     ap.add_argument("--seed", type=int, default=0)

@@ -181,7 +181,7 @@ def validate_mesh(V, F, *, name: str = "mesh", allow_degenerate: bool = False) -
             k = int(np.flatnonzero(zero)[0])
             raise ValueError(
                 f"{name}: {int(zero.sum())} zero-area faces (first: face {k} = {F[k].tolist()}, "
-                f"area {area[k]:.3g}); pass allow_degenerate=True to accept them"
+                f"area {area[k]:.3g}); pass allow_degenerate=True (meshvae: --allow-degenerate) to accept them"
             )
 
 

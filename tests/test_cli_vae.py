@@ -165,3 +165,22 @@ def test_evaluate_with_codes_fitted_to_the_vertices(data, capsys):
     res = json.loads(capsys.readouterr().out)
     assert res["fit_iterations"] == 2 and res["mean_vertex_error"] <= plain + 1e-12
     assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 1
+
+
+def test_train_and_evaluate_accept_degenerate_faces_only_when_asked(tmp_path, capsys):
+    coll = _strips(n=8)
+    V = coll.vertices.copy()
+    V[5, 1] = 0.5 * (V[5, 0] + V[5, 3])  # face 0 = [0, 3, 1] of mesh 5 collapses to a segment
+    path = write_collection(tmp_path / "flat.npz", MeshCollection(V, coll.faces, names=coll.names, labels={}))
+    out = tmp_path / "m.pt"
+    args = ["train", str(path), "-o", str(out), "--epochs", "2", "--latent", "3", "--no-progress"]
+    capsys.readouterr()
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "zero-area" in err and "--allow-degenerate" in err
+    assert main(args + ["--allow-degenerate"]) == 0 and out.exists()
+    assert main(["evaluate", str(out), str(path)]) == 1
+    capsys.readouterr()
+    assert main(["evaluate", str(out), str(path), "--allow-degenerate", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["n_meshes"] == 8 and np.isfinite(res["mean_vertex_error"])

@@ -95,8 +95,8 @@ def test_state_dict_round_trip(kind):
 
 def test_default_hidden_layers():
     assert default_hidden("rimd") == ()
-    assert default_hidden("coords") == tuple(HIDDEN_COORDS) == default_hidden("aligned") == (256,)
-    assert default_hidden("coords", "pca") == () == default_hidden("rimd", "pca")
+    assert default_hidden("coords", "random") == tuple(HIDDEN_COORDS) == default_hidden("aligned", "random") == (256,)
+    assert default_hidden("coords") == () == default_hidden("rimd", "pca") == default_hidden("rimd", "random")
     with pytest.raises(ValueError):
         default_hidden("nope")
 

@@ -186,7 +186,9 @@ def test_pca_network_starts_at_the_pca_reconstruction():
 
 def test_pca_start_chooses_the_epochs_by_early_stopping_on_training_rows():
     X = _in_range(n=40)
-    assert not TrainConfig().uses_pca_init() and not TrainConfig().resolved_early_stopping()  # the paper's default
+    assert TrainConfig().uses_pca_init() and TrainConfig().resolved_early_stopping()  # the library's default
+    paper = TrainConfig(init="random")  # the paper's training: random start, a = 0.9, all epochs
+    assert not paper.uses_pca_init() and not paper.resolved_early_stopping() and paper.resolved_feature_range() == 0.9
     cfg = TrainConfig(epochs=50, latent_dim=8, progress=False, eval_every=5, patience=20, init="pca")
     assert cfg.uses_pca_init() and cfg.resolved_early_stopping() and cfg.resolved_feature_range() == 0.3
     res = train_vae(X, config=cfg, val_features=X[:2])

@@ -42,6 +42,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         " not held out (no value), or all meshes of the collection TRAIN")
     p.add_argument("--pca-components", type=int, default=None, metavar="K",
                    help="principal components of the PCA baseline (default: all the training meshes span)")
+    p.add_argument("--allow-degenerate", action="store_true",
+                   help="accept zero-area faces (they get the fallback cotangent weight)")
     p.set_defaults(func=run)
     return p
 
@@ -51,7 +53,7 @@ def run(args) -> int:
     from ..evaluation import evaluate_model
     from ..mesh_io import read_collection
 
-    collection = read_collection(args.data)
+    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
     if args.fit_latent < 0:
         raise ValueError(f"--fit-latent must be >= 0, got {args.fit_latent}")
@@ -62,7 +64,7 @@ def run(args) -> int:
         from ..evaluation import pca_baseline
 
         if args.pca:
-            train = read_collection(args.pca)
+            train = read_collection(args.pca, allow_degenerate=args.allow_degenerate)
             model.check_compatible(train)
             V_train = np.asarray(train.vertices, dtype=np.float64)
         else:
@@ -78,7 +80,7 @@ def run(args) -> int:
     else:
         worst = max(range(res["n_meshes"]), key=lambda i: res["per_mesh"][i])
         print(f"mean per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
-              f" ({100 * res['relative_error']:.3f}% of the bounding-box diagonal; features {res['features']}"
+              f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal; features {res['features']}"
               + (f"; codes fitted to the vertices, {args.fit_latent} steps" if args.fit_latent else "") + ")")
         print(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
         if "pca" in res:

@@ -29,6 +29,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=10, metavar="S", help="meshes in the sequence, ends included (default 10)")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help=".npz file or folder for OBJ files")
     p.add_argument("--data", default=None, metavar="DATA", help="collection that A and B index into")
+    p.add_argument("--allow-degenerate", action="store_true",
+                   help="accept zero-area faces (they get the fallback cotangent weight)")
     p.set_defaults(func=run)
     return p
 
@@ -64,7 +66,7 @@ def run(args) -> int:
 
     if args.steps < 2:
         raise ValueError(f"--steps must be >= 2 (both ends are included), got {args.steps}")
-    collection = read_collection(args.data) if args.data else None
+    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate) if args.data else None
     model = load_model(args.model, collection)
     ends = []
     for spec, what in ((args.a, "A"), (args.b, "B")):

@@ -14,10 +14,12 @@ Train a mesh VAE (Tan et al., CVPR 2018) on a collection of meshes that share on
 and write everything needed to use it (weights, normaliser, reference mesh, faces, labels) to one
 checkpoint file. DATA is an .npz collection or a folder of OBJ/PLY/OFF files (+ labels.csv).
 The defaults train a good model for 50-200 meshes; a progress bar shows the epochs.
-By default it trains as the paper does (random start, all --epochs). With --init pca a network
-without internal layers, with the standard prior and no labels starts as the PCA of the training
-features and early stopping on every 8th training mesh chooses how many of the --epochs to train
-(possibly none); see docs/vae.md, "Generalisation on real meshes".
+By default (--init pca) a network without internal layers, with the standard prior and no labels
+starts as the PCA of the training features, and early stopping on every 8th training mesh chooses
+how many of the --epochs to train (possibly none): on real meshes this generalises far better than
+the paper's training (docs/vae.md, "Generalisation on real meshes"). --init random
+--no-early-stopping trains as the paper does (random start, a = 0.9, all --epochs); conditional
+networks, internal layers and a sigma_object prior always start at random.
 
 examples:
   meshvae train scape.npz -o scape.pt
@@ -52,8 +54,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--epochs", type=int, default=None, metavar="E",
                    help=f"training epochs, the most early stopping may choose (default {d.epochs})")
     p.add_argument("--init", choices=INIT_MODES, default=d.init,
-                   help="pca: start from the PCA of the training features (an option, docs/vae.md; networks without internal"
-                        " layers, standard prior, no labels); random (default): PyTorch's initialisation (the paper)")
+                   help="pca (default): start from the PCA of the training features (networks without internal"
+                        " layers, standard prior, no labels; docs/vae.md); random: PyTorch's initialisation (the paper)")
     p.add_argument("--no-early-stopping", action="store_true",
                    help="train all --epochs instead of choosing them on every 8th training mesh")
     p.add_argument("--alpha", type=float, default=DEFAULT_ALPHA, metavar="A",
@@ -76,6 +78,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
     p.add_argument("--device", default="auto", help="auto (GPU when available), cpu, cuda, ... (default auto)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument("--allow-degenerate", action="store_true",
+                   help="accept zero-area faces (they get the fallback cotangent weight)")
     p.set_defaults(func=run)
     return p
 
@@ -86,7 +90,7 @@ def run(args) -> int:
     from ..mesh_io import read_collection
     from ..training import TrainConfig, default_hidden
 
-    collection = read_collection(args.data)
+    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     if args.latent < 1:
         raise ValueError(f"--latent must be >= 1, got {args.latent}")
     if args.sigma_object is not None and len(args.sigma_object) > args.latent:
@@ -114,6 +118,6 @@ def run(args) -> int:
     if model.holdout_mask_.any():
         res = evaluate_model(model, collection, held_out_only=True)
         print(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
-              f" ({100 * res['relative_error']:.3f}% of the bounding-box diagonal)")
+              f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal)")
     print(f"wrote {args.output}")
     return 0
