@@ -14,7 +14,7 @@ LOCK := constraints.txt
 # torch's generic (non-AVX) kernels on one thread, and MKL's reproducible "compatible" code path.
 PORTABLE_SETTINGS := "ATEN_CPU_CAPABILITY=default MESHVAE_NUM_THREADS=1" "MKL_CBWR=COMPATIBLE"
 
-.PHONY: venv lock lab test test-fast test-portable browser notebooks course student experiments bench clean help
+.PHONY: venv lock lab test test-fast test-portable browser models notebooks course student experiments bench clean help
 
 help:
 	@echo "make lab          set up .venv and open JupyterLab on notebooks/"
@@ -22,6 +22,7 @@ help:
 	@echo "make test-fast    unit tests only (no notebooks, no browser)"
 	@echo "make test-portable  re-run every notebook under changed float settings against its stored outputs"
 	@echo "make lock         re-resolve the packages and rewrite $(LOCK) (then re-run make notebooks and make test)"
+	@echo "make models       train the course's models that are not cached yet (~/.cache/meshvae, or \$$MESHVAE_CACHE)"
 	@echo "make notebooks    re-execute every notebook in place (refreshes the stored outputs)"
 	@echo "make course       execute all notebooks and write an HTML course to $(BUILD)/course"
 	@echo "make student      write student copies without solutions to $(BUILD)/student"
@@ -55,11 +56,11 @@ browser:
 lab: $(STAMP)
 	$(BIN)/jupyter lab notebooks/ $(if $(filter 0,$(shell id -u)),--allow-root)
 
-test: $(STAMP) browser
+test: $(STAMP) browser models
 	$(BIN)/python -m pytest tests notebooks $(PYTEST_NB)
 
 # The stored outputs must hold under other float summation orders, as on another machine.
-test-portable: $(STAMP)
+test-portable: $(STAMP) models
 	@for s in $(PORTABLE_SETTINGS); do \
 	  echo "== notebooks under $$s"; \
 	  env $$s $(BIN)/python -m pytest notebooks $(PYTEST_NB) -p no:cacheprovider -q || exit 1; \
@@ -68,7 +69,12 @@ test-portable: $(STAMP)
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest tests -m "not browser and not slow"
 
-notebooks: $(STAMP)
+# The course's trained models live in a cache outside the clone (meshvae_lib/course/models.py);
+# this builds the missing ones. A notebook that needs a missing model trains it itself.
+models: $(STAMP)
+	$(BIN)/python -m meshvae_lib.course models
+
+notebooks: $(STAMP) models
 	$(BIN)/python -m meshvae_lib.course execute $(NOTEBOOKS)
 
 course: $(STAMP)

@@ -424,6 +424,9 @@ def save_model(path, model: MeshVAEModel) -> Path:
     return path
 
 
+_ZIP_MAGIC = b"PK\x03\x04"
+
+
 def load_model(path, collection=None) -> MeshVAEModel:
     """Read a checkpoint written by :func:`save_model`.
 
@@ -437,6 +440,11 @@ def load_model(path, collection=None) -> MeshVAEModel:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no checkpoint file at {path}")
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head != _ZIP_MAGIC:  # torch.save's format is a zip archive; torch would advise unsafe loading
+        raise ValueError(f"{path} is damaged or not a mesh VAE checkpoint: it does not start like one"
+                         f" (first bytes {head!r}; zero-filled, overwritten or another kind of file)")
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except (RuntimeError, EOFError, OSError, ValueError, zipfile.BadZipFile, KeyError, IndexError,

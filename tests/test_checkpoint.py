@@ -107,9 +107,13 @@ def test_corrupted_truncated_and_foreign_files_give_clear_errors(model, tmp_path
     torch.save({"weights": torch.zeros(3)}, tmp_path / "other.pt")
     with open(tmp_path / "pickle.pt", "wb") as fh:
         pickle.dump(np.zeros(3), fh, protocol=2)
-    for name in ("trunc.pt", "noise.pt", "text.pt", "other.pt", "pickle.pt"):
-        with pytest.raises(ValueError, match="checkpoint"):
+    (tmp_path / "zeros.pt").write_bytes(bytes(len(good)))
+    for name in ("trunc.pt", "noise.pt", "text.pt", "other.pt", "pickle.pt", "zeros.pt"):
+        with pytest.raises(ValueError, match="checkpoint") as info:
             load_model(tmp_path / name)
+        assert "weights_only" not in str(info.value), name  # never advise unsafe loading
+    with pytest.raises(ValueError, match="damaged"):
+        load_model(tmp_path / "zeros.pt")
     # flip bytes inside the stored weights: the checksum catches what the zip reader does not
     payload = torch.load(tmp_path / "m.pt", weights_only=True)
     key = next(iter(payload["network_state"]))

@@ -5,8 +5,9 @@ from __future__ import annotations
 import nbformat
 import pytest
 
-from meshvae_lib.course import (STUDENT_PLACEHOLDER, coalesce_streams, inject_parameters, main, strip_solutions,
-                                 student_notebook)
+from meshvae_lib.course.commands import main
+from meshvae_lib.course.notebooks import (STUDENT_PLACEHOLDER, coalesce_streams, inject_parameters, strip_solutions,
+                                           student_notebook)
 
 
 def test_strip_solutions_replaces_block_and_keeps_the_rest():

@@ -13,7 +13,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from meshvae_lib.course import BEGIN_SOLUTION, END_SOLUTION, student_notebook
+from meshvae_lib.course.notebooks import BEGIN_SOLUTION, END_SOLUTION, student_notebook
 
 NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))

@@ -1,0 +1,192 @@
+"""The course's models: trained once at a real budget, cached outside the clone, loaded in seconds.
+
+Each entry of :data:`COURSE_MODELS` names a ``data_synth`` collection (name, seed, resolution), what
+the lesson needs from the model (features, labels, a sigma_object prior) and a training budget.
+:func:`course_model` returns the fitted :class:`~meshvae_lib.checkpoint.MeshVAEModel`: from the
+cache when an entry with the same key is there, else trained (with a progress bar), written to the
+cache and returned.
+
+The cache lives in ``$MESHVAE_CACHE`` when set, else ``$XDG_CACHE_HOME/meshvae``, else
+``~/.cache/meshvae`` (:func:`cache_dir`). An entry's file name holds its key (:func:`model_key`): a
+hash of everything that determines the model -- the specification, the full training
+configuration, the numpy and torch versions and the source code of the library layers that make
+the data and train the model. A change to any of them gives another key, so a stale entry is never
+loaded; it is removed when the new one is written. A damaged entry (a failed checksum, a truncated
+file) is logged, removed and rebuilt. Checkpoints are written atomically
+(:func:`~meshvae_lib.checkpoint.save_model`), so an interrupted build leaves no half-written entry.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+logger = logging.getLogger(__name__)
+
+#: environment variable that overrides the cache folder.
+CACHE_ENV = "MESHVAE_CACHE"
+
+#: the library folders whose source determines a trained model (the data, geometry and model layers;
+#: not the viewers, the command line or this course layer).
+_CODE_EXCLUDED = ("viewing", "cli", "course")
+
+
+@dataclass(frozen=True)
+class CourseModelSpec:
+    """One course model: the data, the model and its training budget.
+
+    name : registry key; lesson : the notebook that uses it; collection : a ``data_synth`` name;
+    resolution : template vertices (approximate); data_seed : the collection's seed;
+    features, labels, layout, holdout_every : :class:`~meshvae_lib.checkpoint.MeshVAEModel`'s
+    arguments; config : :class:`~meshvae_lib.training.TrainConfig` keywords (the budget: ``epochs``,
+    ``latent_dim``, ...; ``progress`` is set by :func:`course_model`); minutes : the measured build
+    time on 2 CPU cores, for the message shown before a build; description : one line.
+    """
+
+    name: str
+    lesson: str
+    collection: str
+    resolution: int | None
+    description: str
+    minutes: float
+    data_seed: int = 0
+    features: str = "rimd"
+    labels: tuple[str, ...] = ()
+    layout: str = "compact"
+    holdout_every: int = 5
+    config: dict = field(default_factory=dict)
+
+    def train_config(self, progress: bool = False):
+        """The :class:`~meshvae_lib.training.TrainConfig` this model is trained with."""
+        from meshvae_lib.training import TrainConfig
+
+        return TrainConfig(**{"device": "cpu", **self.config, "progress": progress})
+
+    def make_collection(self):
+        """The ``data_synth`` collection this model is trained on (deterministic)."""
+        from data_synth.registry import make_collection
+
+        return make_collection(self.collection, seed=self.data_seed, resolution=self.resolution)
+
+
+COURSE_MODELS: dict[str, CourseModelSpec] = {
+    spec.name: spec
+    for spec in (
+        CourseModelSpec(
+            name="generation-body",
+            lesson="05_generation_interpolation",
+            collection="scape",
+            resolution=2000,
+            description="one body in 71 poses, 2,000 vertices, every 5th held out; the library's defaults, latent 128",
+            minutes=1.0,
+            config={"epochs": 1000, "latent_dim": 128, "batch_size": 16, "seed": 0},
+        ),
+    )
+}
+
+
+def cache_dir() -> Path:
+    """The cache folder: ``$MESHVAE_CACHE``, else ``$XDG_CACHE_HOME/meshvae``, else ``~/.cache/meshvae``."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV]).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base).expanduser() / "meshvae"
+
+
+def code_fingerprint() -> str:
+    """sha256 of the source files of ``data_synth`` and of ``meshvae_lib`` without its viewing,
+    command-line and course folders (their relative paths and bytes, in sorted order)."""
+    import data_synth
+    import meshvae_lib
+
+    h = hashlib.sha256()
+    for package in (meshvae_lib, data_synth):
+        root = Path(package.__file__).parent
+        for path in sorted(root.rglob("*.py")):
+            rel = path.relative_to(root)
+            if rel.parts[0] in _CODE_EXCLUDED:
+                continue
+            h.update(f"{package.__name__}/{rel.as_posix()}\0".encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def model_key(spec: CourseModelSpec) -> str:
+    """The cache key of ``spec``: sha256 (hex) of the specification, its full training configuration,
+    the numpy and torch versions and :func:`code_fingerprint`."""
+    import numpy
+    import torch
+
+    what = {
+        "spec": {k: v for k, v in asdict(spec).items() if k not in ("description", "minutes", "lesson")},
+        "train_config": spec.train_config().to_dict(),
+        "versions": {"numpy": numpy.__version__, "torch": torch.__version__.split("+")[0]},
+        "code": code_fingerprint(),
+    }
+    return hashlib.sha256(json.dumps(what, sort_keys=True, default=list).encode()).hexdigest()
+
+
+def cache_path(name: str, key: str | None = None) -> Path:
+    """Where the entry of course model ``name`` (with ``key``, default: its current key) lives."""
+    spec = get_spec(name)
+    return cache_dir() / f"{spec.name}-{(key or model_key(spec))[:20]}.pt"
+
+
+def get_spec(name: str) -> CourseModelSpec:
+    """The registry entry ``name``; ValueError listing the names for an unknown one."""
+    if name not in COURSE_MODELS:
+        raise ValueError(f"unknown course model {name!r}; the course has {sorted(COURSE_MODELS)}")
+    return COURSE_MODELS[name]
+
+
+def is_cached(name: str) -> bool:
+    """Whether an entry with the current key exists (it is not opened: see :func:`course_model`)."""
+    return cache_path(name).is_file()
+
+
+def build_model(name: str, progress: bool = True):
+    """Train course model ``name`` from scratch (no cache). Returns the fitted MeshVAEModel."""
+    from meshvae_lib.checkpoint import MeshVAEModel
+
+    spec = get_spec(name)
+    model = MeshVAEModel(spec.features, spec.train_config(progress), labels=spec.labels,
+                         holdout_every=spec.holdout_every, layout=spec.layout)
+    return model.fit(spec.make_collection())
+
+
+def course_model(name: str, progress: bool = True, rebuild: bool = False):
+    """The fitted course model ``name`` (a :class:`~meshvae_lib.checkpoint.MeshVAEModel`).
+
+    Loaded from the cache when an entry with the current key is there and reads back intact; else
+    trained (a progress bar when ``progress``; a log message says how long the build takes),
+    written to the cache atomically, and returned. ``rebuild``: train even when cached. Older
+    entries of the same model (other keys) are removed when a new one is written.
+    """
+    from meshvae_lib.checkpoint import load_model
+
+    spec = get_spec(name)
+    key = model_key(spec)
+    path = cache_path(name, key)
+    if path.is_file() and not rebuild:
+        try:
+            return load_model(path)
+        except (ValueError, OSError) as exc:
+            logger.warning("course model %r: the cached file %s is damaged (%s); rebuilding it", name, path, exc)
+            path.unlink(missing_ok=True)
+    logger.warning("course model %r is not in the cache (%s): training it, about %.0f min on 2 CPU cores",
+                   name, cache_dir(), max(spec.minutes, 1.0))
+    start = time.perf_counter()
+    model = build_model(name, progress=progress)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    model.save(path)
+    for old in path.parent.glob(f"{spec.name}-*.pt"):
+        tail = old.stem[len(spec.name) + 1:]
+        if old != path and len(tail) == 20 and all(c in "0123456789abcdef" for c in tail):
+            old.unlink(missing_ok=True)
+    logger.info("course model %r trained in %.0f s and cached at %s", name, time.perf_counter() - start, path)
+    return load_model(path)  # what a later call loads, bit for bit (eval mode, float32 weights)

@@ -1,0 +1,133 @@
+"""The course models' registry and cache (meshvae_lib.course.models)."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from meshvae_lib.course import models as cm
+from meshvae_lib.course.commands import main
+from meshvae_lib.training import TrainConfig
+
+NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+
+TINY = cm.CourseModelSpec(name="tiny-bar", lesson="test", collection="bar", resolution=300, description="a test model",
+                          minutes=0.1, config={"epochs": 3, "latent_dim": 4, "batch_size": 16, "seed": 0})
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv(cm.CACHE_ENV, str(tmp_path / "cache"))
+    monkeypatch.setitem(cm.COURSE_MODELS, TINY.name, TINY)
+    return tmp_path / "cache"
+
+
+def test_cache_dir_follows_the_environment(tmp_path, monkeypatch):
+    monkeypatch.setenv(cm.CACHE_ENV, str(tmp_path / "a"))
+    assert cm.cache_dir() == tmp_path / "a"
+    monkeypatch.delenv(cm.CACHE_ENV)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert cm.cache_dir() == tmp_path / "xdg" / "meshvae"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    assert cm.cache_dir() == Path.home() / ".cache" / "meshvae"
+
+
+def test_every_registered_model_is_well_formed():
+    assert cm.COURSE_MODELS, "the course has models"
+    for name, spec in cm.COURSE_MODELS.items():
+        assert spec.name == name
+        assert (NOTEBOOKS / f"{spec.lesson}.ipynb").is_file(), spec.lesson
+        assert isinstance(spec.train_config(), TrainConfig)  # every config key is a TrainConfig field
+        assert spec.resolution is not None and spec.resolution >= 1500, (name, spec.resolution)
+    with pytest.raises(ValueError, match="generation-body"):
+        cm.get_spec("no-such-model")
+
+
+def test_the_key_changes_with_anything_that_determines_the_model(monkeypatch):
+    key = cm.model_key(TINY)
+    assert key == cm.model_key(dataclasses.replace(TINY)) and len(key) == 64
+    assert cm.model_key(dataclasses.replace(TINY, description="other words", minutes=5)) == key
+    for change in ({"resolution": 400}, {"data_seed": 1}, {"features": "coords"}, {"holdout_every": 4},
+                   {"config": {**TINY.config, "epochs": 4}}, {"config": {**TINY.config, "lr": 1e-4}}):
+        assert cm.model_key(dataclasses.replace(TINY, **change)) != key, change
+    monkeypatch.setattr(cm, "code_fingerprint", lambda: "other code")
+    assert cm.model_key(TINY) != key
+
+
+def test_code_fingerprint_covers_the_model_layers_not_the_viewers():
+    import meshvae_lib
+
+    root = Path(meshvae_lib.__file__).parent
+    before = cm.code_fingerprint()
+    assert before == cm.code_fingerprint()
+    probe = root / "viewing" / "_fingerprint_probe.py"
+    probe.write_text("x = 1\n")
+    try:
+        assert cm.code_fingerprint() == before  # a viewer change does not invalidate trained models
+    finally:
+        probe.unlink()
+    probe = root / "_fingerprint_probe.py"
+    probe.write_text("x = 1\n")
+    try:
+        assert cm.code_fingerprint() != before
+    finally:
+        probe.unlink()
+
+
+def test_course_model_builds_once_then_loads(cache, monkeypatch):
+    assert not cm.is_cached(TINY.name)
+    first = cm.course_model(TINY.name, progress=False)
+    path = cm.cache_path(TINY.name)
+    assert path.is_file() and path.parent == cache and cm.is_cached(TINY.name)
+
+    def no_training(*a, **k):
+        raise AssertionError("a cached model must not be trained again")
+
+    monkeypatch.setattr(cm, "build_model", no_training)
+    again = cm.course_model(TINY.name, progress=False)
+    z = np.random.default_rng(0).standard_normal((3, 4))
+    np.testing.assert_array_equal(first.decode_latent(z), again.decode_latent(z))
+    np.testing.assert_array_equal(first.holdout_mask_, again.holdout_mask_)
+
+
+@pytest.mark.parametrize("damage", ["truncate", "zeros"])
+def test_a_damaged_entry_is_rebuilt_not_loaded(cache, caplog, damage):
+    model = cm.course_model(TINY.name, progress=False)
+    path = cm.cache_path(TINY.name)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2] if damage == "truncate" else bytes(len(data)))
+    with caplog.at_level(logging.WARNING, logger=cm.__name__):
+        rebuilt = cm.course_model(TINY.name, progress=False)
+    assert "damaged" in caplog.text
+    z = np.zeros((1, 4))
+    np.testing.assert_array_equal(model.decode_latent(z), rebuilt.decode_latent(z))  # training is seeded
+    assert cm.course_model(TINY.name, progress=False) is not None and path.read_bytes()[:4] == b"PK\x03\x04"
+
+
+def test_a_stale_entry_is_replaced(cache, monkeypatch):
+    cm.course_model(TINY.name, progress=False)
+    old = cm.cache_path(TINY.name)
+    unrelated = cache / "tiny-bar-extra-0123456789abcdef0123.pt"  # another model's name, not an old key
+    unrelated.write_bytes(b"x")
+    monkeypatch.setattr(cm, "code_fingerprint", lambda: "the library changed")
+    new = cm.cache_path(TINY.name)
+    assert new != old and not cm.is_cached(TINY.name)
+    cm.course_model(TINY.name, progress=False)
+    assert new.is_file() and not old.exists() and unrelated.exists()
+
+
+def test_models_command_lists_and_builds(cache, capsys):
+    assert main(["models", "--list", TINY.name]) == 0
+    out = capsys.readouterr().out
+    assert "tiny-bar" in out and "missing" in out and str(cache) in out
+    assert main(["models", TINY.name, "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "tiny-bar: built in" in out and "1 course model(s) ready" in out
+    assert main(["models", TINY.name, "--no-progress"]) == 0
+    assert "tiny-bar: cached" in capsys.readouterr().out
+    assert main(["models", "nope"]) == 1
+    assert "unknown course model" in capsys.readouterr().err
