@@ -2,7 +2,10 @@
 
     .venv/bin/python benchmarks/experiments.py --out build/experiments [--quick] [--only table1,embedding]
 
-``make experiments`` runs it at full size (about 30 minutes on two CPU cores). Writes, in ``--out``:
+``make experiments`` runs it at full size (about 30 minutes on two CPU cores) into ``docs/results``, whose
+tables are committed: notebook 09 shows them, and a test fails when the experiments change after they
+were recorded (``results.json`` holds the definitions' fingerprint, the commit, the package versions,
+the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
   ``meshvae_lib.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
@@ -35,8 +38,8 @@ from meshvae_lib import experiments as exps  # noqa: E402
 
 SHORT = {
     "table1": exps.latent_size_table,
-    "table3": exps.feature_table,
-    "table4": exps.robustness_table,
+    "table2": exps.feature_table,
+    "table3": exps.robustness_table,
     "loss": exps.loss_table,
     "embedding": exps.embedding_table,
     "generation": exps.generation_table,
@@ -104,7 +107,7 @@ def _jsonable(table) -> dict:
             return int(c)
         return None if c is None else str(c)
 
-    return {"title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
+    return {"name": table.name, "title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
             "notes": table.notes, "seconds": table.seconds}
 
 
@@ -116,7 +119,35 @@ def _write_summary(out, args, settings, total, parts, results, failed, done: boo
               f"Settings: `{dataclasses.asdict(settings)}`\n\n")
     (out / "summary.md").write_text(header + "\n".join(parts))
     (out / "results.json").write_text(json.dumps({"settings": dataclasses.asdict(settings), "seconds": total,
-                                                  "done": done, "failed": failed, "tables": results}, indent=1))
+                                                  "done": done, "failed": failed, "provenance": _provenance(args, settings),
+                                                  "tables": results}, indent=1))
+
+
+def _provenance(args, settings) -> dict:
+    """What the numbers depend on: the experiments' definitions, the commit, versions, the machine."""
+    import platform
+    import subprocess
+
+    import scipy
+    import torch
+
+    def git(*a):
+        try:
+            return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+        except (OSError, subprocess.CalledProcessError):
+            return None
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return {"definition_fingerprint": exps.definition_fingerprint(settings), "commit": git("rev-parse", "HEAD"),
+            "uncommitted_changes": bool(git("status", "--porcelain", "--untracked-files=no")),
+            "versions": {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
+                         "torch": torch.__version__},
+            "machine": {"cpu": cpu, "cores": os.cpu_count(), "torch_threads": args.threads, "system": platform.platform()},
+            "preset": "quick" if args.quick else "full"}
 
 
 def main(argv=None) -> int:

@@ -79,7 +79,7 @@ class MeshVAEModel:
 
     Parameters
     ----------
-    features : "rimd" | "aligned" | "coords" (the paper's Table 3; "rimd" is the mesh VAE proper).
+    features : "rimd" | "aligned" | "coords" (the paper's Table 2; "rimd" is the mesh VAE proper).
     config : :class:`~meshvae_lib.training.TrainConfig` (defaults when None).
     labels : label columns to condition on (conditional mesh VAE, Eq. 5); empty: unconditional.
     holdout_every : hold out every k-th mesh (k >= 2) from training to measure generalisation;

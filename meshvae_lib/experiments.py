@@ -5,8 +5,8 @@ One function per experiment; each returns an :class:`ExperimentTable` (rows a no
 
 ============================  ==============================================================
 ``latent_size_table``         Table 1: held-out per-vertex error for latent sizes 16/128/256
-``feature_table``             Table 3: RIMD vs 3D coordinates vs aligned coordinates
-``robustness_table``          Table 4: the choice of reference (base) mesh and mesh density
+``feature_table``             Table 2: RIMD vs 3D coordinates vs aligned coordinates
+``robustness_table``          Table 3: the choice of reference (base) mesh and mesh density
 ``loss_table``                Sec. 5.1 "MSE loss": MSE vs sigmoid + binary cross-entropy
 ``embedding_table``           Sec. 5.4: 2D embeddings (sigma_object VAE, PCA, NPE, t-SNE), AUC
 ``generation_table``          Sec. 5.2: generation, nearest neighbours, conditional generation
@@ -48,6 +48,9 @@ __all__ = [
     "interpolation_table",
     "exploration_table",
     "ALL_EXPERIMENTS",
+    "definition_fingerprint",
+    "RecordedResults",
+    "read_results",
 ]
 
 logger = logging.getLogger(__name__)
@@ -56,8 +59,8 @@ logger = logging.getLogger(__name__)
 PAPER = {
     # Table 1: (scale, [16, 128, 256])
     "table1": {"jumping": (1e-4, [4.9129, 4.4325, 4.2442]), "face": (1e-2, [8.3833, 7.8025, 7.9192])},
-    # Table 3: (n shapes, scale, [3D coordinates, aligned coordinates, RIMD])
-    "table3": {
+    # Table 2: (n shapes, scale, [3D coordinates, aligned coordinates, RIMD])
+    "table2": {
         "scape": (71, 1e-3, [15.7249, 7.3582, 3.7418]),
         "jumping": (150, 1e-4, [49.4876, 11.2226, 4.4325]),
         "bouncing": (75, 1e-4, [28.1823, 6.6970, 3.7358]),
@@ -65,8 +68,8 @@ PAPER = {
         "flag": (90, 1e-3, [29.5490, 2.4462, 1.7916]),
         "dyna": (2168, 1e-3, [2.9488, 1.7634, 1.2128]),
     },
-    # Table 4 (chicken wings, Dyna): (base mesh, points, error x 1e-4)
-    "table4": [("No. 1", 6890, 2.77), ("No. 1", 6002, 2.49), ("No. 1", 8002, 3.01),
+    # Table 3 (chicken wings, Dyna): (base mesh, points, error x 1e-4)
+    "table3": [("No. 1", 6890, 2.77), ("No. 1", 6002, 2.49), ("No. 1", 8002, 3.01),
                ("No. 6", 6890, 2.85), ("No. 72", 6890, 2.80)],
     # Sec. 5.4: retrieval AUC on Dyna
     "auc": {"sigma_object VAE": 0.5168, "t-SNE": 0.4961, "PCA": 0.2272, "NPE": 0.1391},
@@ -418,7 +421,7 @@ def latent_size_table(collections: Sequence[str] = ("jumping", "face"), latent_d
 
 
 # --------------------------------------------------------------------------------------------
-# Table 3: features
+# Table 2: features
 # --------------------------------------------------------------------------------------------
 
 
@@ -426,7 +429,7 @@ def latent_size_table(collections: Sequence[str] = ("jumping", "face"), latent_d
 def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "aligned", "rimd"),
                   settings: ExperimentSettings | None = None, quick: bool = False,
                   cache: dict | None = None) -> ExperimentTable:
-    """Paper Table 3: held-out error with 3D coordinates, aligned coordinates and RIMD features.
+    """Paper Table 2: held-out error with 3D coordinates, aligned coordinates and RIMD features.
 
     ``collections``: default every ``data_synth`` collection. The same network (and training
     budget) is used for the three inputs. Returns one row per collection with our three errors,
@@ -439,7 +442,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
     names = _available(collections)
     cols = (["collection [N]"] + [f"ours {k}" for k in kinds] + ["RIMD vs coords", "RIMD vs aligned"]
             + [f"paper {k}" for k in ("coords", "aligned", "rimd")])
-    table = ExperimentTable("table3_features", "Table 3: held-out per-vertex error by input feature", cols)
+    table = ExperimentTable("table2_features", "Table 2: held-out per-vertex error by input feature", cols)
     table.data["errors"] = {}
     for entry in names:
         name = _name_of(entry)
@@ -452,7 +455,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
                     ", ".join(f"{k} {v:.4e}" for k, v in errs.items()))
         red_c = 1 - errs["rimd"] / errs["coords"] if "coords" in errs and "rimd" in errs else None
         red_a = 1 - errs["rimd"] / errs["aligned"] if "aligned" in errs and "rimd" in errs else None
-        paper = PAPER["table3"].get(name)
+        paper = PAPER["table2"].get(name)
         pcells = [p * paper[1] for p in paper[2]] if paper else [None] * 3
         table.rows.append([f"{name} [{len(coll.vertices)}]"] + [errs[k] for k in kinds]
                           + [None if red_c is None else f"{100 * red_c:.0f}%",
@@ -465,7 +468,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
 
 
 # --------------------------------------------------------------------------------------------
-# Table 4: reference mesh and density
+# Table 3: reference mesh and density
 # --------------------------------------------------------------------------------------------
 
 
@@ -488,7 +491,7 @@ def _density_resolutions(base: int) -> tuple[int, int, int]:
 def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolutions=None,
                      settings: ExperimentSettings | None = None, quick: bool = False,
                      cache: dict | None = None) -> ExperimentTable:
-    """Paper Table 4: held-out error with other reference meshes and other mesh densities.
+    """Paper Table 3: held-out error with other reference meshes and other mesh densities.
 
     The first reference is trained at every resolution (default: 0.8x, 1x and 1.25x the
     settings' resolution, the paper's 6002 / 6890 / 8002 points); the others at the settings'
@@ -502,14 +505,14 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     resolutions = [int(r) for r in resolutions]
     cols = ["base mesh", "points (asked)", "points", "error", "relative error", "paper base", "paper points",
             "paper error"]
-    table = ExperimentTable("table4_robustness", "Table 4: held-out error vs reference mesh and mesh density", cols)
+    table = ExperimentTable("table3_robustness", "Table 3: held-out error vs reference mesh and mesh density", cols)
     runs = [(references[0], r) for r in resolutions] + [(ref, resolutions[0]) for ref in references[1:]]
     table.data["runs"] = []
     for i, (ref, res) in enumerate(runs):
         coll = load_collection(collection, s, resolution=res, cache=cache)
         r = _safe_reference(ref, len(coll.vertices), s.holdout_every)
         ev = _heldout_error(_train(coll, s, cache, reference_index=r), coll)
-        paper = PAPER["table4"][i] if i < len(PAPER["table4"]) else (None, None, None)
+        paper = PAPER["table3"][i] if i < len(PAPER["table3"]) else (None, None, None)
         table.rows.append([f"No. {r + 1}", res, coll.vertices.shape[1], ev["mean_vertex_error"], ev["relative_error"],
                            paper[0], paper[1], None if paper[2] is None else paper[2] * 1e-4])
         table.data["runs"].append({"reference": r, "resolution": res, "n_vertices": coll.vertices.shape[1],
@@ -913,7 +916,7 @@ def _plot_table1(table):
     return fig
 
 
-def _plot_table3(table):
+def _plot_table2(table):
     fig = _figure(7.5, 4.0)
     ax = fig.add_subplot(111)
     names = list(table.data["errors"])
@@ -974,7 +977,7 @@ def _plot_embedding(table):
 
 _PLOTS = {
     "table1_latent_size": _plot_table1,
-    "table3_features": _plot_table3,
+    "table2_features": _plot_table2,
     "loss_mse_vs_bce": _plot_loss,
     "embedding_auc": _plot_embedding,
 }
@@ -990,3 +993,57 @@ ALL_EXPERIMENTS = (
     interpolation_table,
     exploration_table,
 )
+
+
+def definition_fingerprint(settings: ExperimentSettings) -> str:
+    """sha256 (hex) of what defines the experiments' numbers: this module's source (the experiments,
+    their training protocol and the paper's reference numbers) and ``settings``. Recorded with
+    committed results (``benchmarks/experiments.py``), so that a test can tell when they are stale."""
+    import dataclasses
+    import hashlib
+    import json
+    from pathlib import Path
+
+    h = hashlib.sha256(Path(__file__).read_bytes())
+    h.update(json.dumps(dataclasses.asdict(settings), sort_keys=True).encode())
+    return h.hexdigest()
+
+
+@dataclass
+class RecordedResults:
+    """A finished run of ``benchmarks/experiments.py`` read back from its ``results.json``.
+
+    tables : dict experiment key (``"table1"``, ``"table2"``, ...) -> ExperimentTable (no ``data``);
+    settings : the ExperimentSettings it ran with; seconds : its total run time; provenance : dict
+    with ``definition_fingerprint``, ``commit``, ``versions``, ``machine``, ``preset``.
+    """
+
+    tables: dict
+    settings: ExperimentSettings
+    seconds: float
+    provenance: dict
+
+    def is_current(self) -> bool:
+        """Whether the experiments are still defined as when these results were recorded."""
+        return self.provenance.get("definition_fingerprint") == definition_fingerprint(self.settings)
+
+
+def read_results(path) -> RecordedResults:
+    """Read a ``results.json`` written by ``benchmarks/experiments.py`` (e.g. the committed
+    ``docs/results/results.json``). ValueError for an unfinished or failed run or a missing field."""
+    import json
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no experiment results at {path} (run `make experiments`)")
+    raw = json.loads(path.read_text())
+    missing = [k for k in ("settings", "seconds", "done", "failed", "tables", "provenance") if k not in raw]
+    if missing:
+        raise ValueError(f"{path} lacks {missing}: not written by benchmarks/experiments.py, or by an older version")
+    if not raw["done"] or raw["failed"]:
+        raise ValueError(f"{path} holds an unfinished or partly failed run (failed: {raw['failed']})")
+    tables = {k: ExperimentTable(t.get("name", k), t["title"], list(t["columns"]), [list(r) for r in t["rows"]],
+                                 list(t.get("notes", [])), {}, float(t.get("seconds", 0.0)))
+              for k, t in raw["tables"].items()}
+    return RecordedResults(tables, ExperimentSettings(**raw["settings"]), float(raw["seconds"]), dict(raw["provenance"]))

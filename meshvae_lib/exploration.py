@@ -24,7 +24,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.alignment import rigid_transform
+from meshvae_lib.alignment import rigid_align, rigid_transform
 
 __all__ = [
     "exploration_sigma_object",
@@ -37,6 +37,7 @@ __all__ = [
     "latent_measurement_correlation",
     "dimension_effects",
     "DimensionEffects",
+    "dimension_displacement",
 ]
 
 #: names returned by ``measure_humanoid``, in order.
@@ -349,3 +350,39 @@ def dimension_effects(model, measure: Callable[[np.ndarray], dict], dims: Sequen
         eff[i] = np.array([M[k][i, -1] - M[k][i, 0] for k in names]) / std
     span = np.stack([np.ptp(M[k], axis=1) for k in names], axis=1) / std
     return DimensionEffects(dims, values, M, corr, eff, names, span)
+
+
+def dimension_displacement(model, dims: Sequence[int] | None = None, base=None,
+                           value_range=tol.EXPLORATION_RANGE, reference_vertices=None) -> np.ndarray:
+    """How far each latent dimension moves the body: the mean vertex distance between the meshes
+    decoded at the two ends of ``value_range`` (the others at ``base``), after rigid alignment.
+
+    Parameters
+    ----------
+    model : trained ``MeshVAEModel`` (``decode_latent``)
+    dims : 0-based dimensions (default: all)
+    base : (D,) values of the other dimensions (default zeros)
+    reference_vertices : (M, n_vertices, 3) meshes whose spread is the unit (the mean vertex
+        distance of a mesh to their mean mesh, averaged over them); default: mesh units
+
+    Returns
+    -------
+    (n_dims,) float64, >= 0.
+    """
+    D = _latent_dim(model)
+    dims = list(range(D)) if dims is None else [int(d) for d in dims]
+    if any(not 0 <= d < D for d in dims):
+        raise ValueError(f"dims must lie in [0, {D}), got {dims}")
+    base = np.zeros(D) if base is None else np.asarray(base, dtype=np.float64)
+    lo, hi = (float(v) for v in value_range)
+    Z = np.broadcast_to(base, (len(dims), 2, D)).copy()
+    Z[np.arange(len(dims)), 0, dims] = lo
+    Z[np.arange(len(dims)), 1, dims] = hi
+    V = np.asarray(model.decode_latent(Z.reshape(-1, D)), dtype=np.float64).reshape(len(dims), 2, -1, 3)
+    A = rigid_align(V[:, 0], V[:, 1])
+    dist = np.linalg.norm(A - V[:, 1], axis=-1).mean(axis=-1)
+    if reference_vertices is not None:
+        R = np.asarray(reference_vertices, dtype=np.float64)
+        spread = float(np.linalg.norm(R - R.mean(axis=0), axis=-1).mean())
+        dist = dist / (spread if spread > 0 else 1.0)
+    return dist

@@ -1,7 +1,7 @@
 """What the network sees: meshes -> feature rows -> meshes, and labels -> condition vectors.
 
 :class:`FeatureExtractor` turns a collection of meshes that share one connectivity into rows of
-features and back. Three kinds, the columns of the paper's Table 3:
+features and back. Three kinds, the columns of the paper's Table 2:
 
 - ``"rimd"``: the RIMD feature of every mesh relative to a reference mesh (Eq. 2), K = 6V + 6E;
   decoding rebuilds the mesh with :class:`~meshvae_lib.reconstruction.RIMDReconstructor`, aligned to
@@ -23,7 +23,7 @@ from .alignment import rigid_align
 
 __all__ = ["FEATURE_KINDS", "FeatureExtractor", "ConditionEncoder"]
 
-#: the feature kinds, in the order of Table 3 (baseline first).
+#: the feature kinds, in the order of Table 2 (baseline first).
 FEATURE_KINDS = ("coords", "aligned", "rimd")
 
 

@@ -70,6 +70,7 @@ def test_code_fingerprint_covers_the_model_layers_not_the_viewers():
         assert cm.code_fingerprint() == before  # a viewer change does not invalidate trained models
     finally:
         probe.unlink()
+    assert "generation.py" in cm._CODE_EXCLUDED and "training.py" not in cm._CODE_EXCLUDED
     probe = root / "_fingerprint_probe.py"
     probe.write_text("x = 1\n")
     try:

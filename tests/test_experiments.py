@@ -1,4 +1,4 @@
-"""The paper's experiments (Tables 1, 3, 4, the loss comparison, Sec. 5.2-5.5) on tiny collections.
+"""The paper's experiments (Tables 1, 2, 3, the loss comparison, Sec. 5.2-5.5) on tiny collections.
 
 Each experiment runs end to end on a 40-mesh bent ellipsoid with shape and motion labels, with a
 few epochs: the tests check the tables' structure, that the numbers are real (finite, positive,
@@ -208,3 +208,44 @@ def test_stable_network_floors_the_deviation_and_train_checks_the_prior_form():
     assert torch.all(s >= exps.tol.SIGMA_FLOOR)  # the deviation the KL sees is never 0
     with pytest.raises(ValueError, match="prior_form"):
         exps._train(exps.load_collection(_make(), SETTINGS), SETTINGS, None, sigma_object=(0.1,), prior="x")
+
+
+RESULTS = __import__("pathlib").Path(__file__).resolve().parents[1] / "docs" / "results" / "results.json"
+
+
+def test_the_committed_full_results_are_current():
+    """docs/results holds a full `make experiments` run (notebook 09 shows it). When the experiments'
+    definitions (meshvae_lib/experiments.py or the default settings) change, it is stale: rerun
+    `make experiments` and commit docs/results."""
+    res = exps.read_results(RESULTS)
+    assert res.provenance["preset"] == "full" and res.settings == exps.ExperimentSettings()
+    assert res.is_current(), "the experiments changed after docs/results was recorded: run `make experiments`"
+    assert {"table1", "table2", "table3", "loss"} <= set(res.tables)
+    for key in ("commit", "versions", "machine"):
+        assert res.provenance.get(key), key
+
+
+def test_definition_fingerprint_and_read_results(tmp_path):
+    import json
+
+    s = exps.ExperimentSettings()
+    fp = exps.definition_fingerprint(s)
+    assert fp == exps.definition_fingerprint(exps.ExperimentSettings()) and len(fp) == 64
+    assert exps.definition_fingerprint(exps.ExperimentSettings(train_steps=301)) != fp
+    table = {"name": "table1", "title": "t", "columns": ["a", "b"], "rows": [["x", 1.5]], "notes": [], "seconds": 2.0}
+    raw = {"settings": __import__("dataclasses").asdict(s), "seconds": 3.0, "done": True, "failed": [],
+           "tables": {"table1": table}, "provenance": {"definition_fingerprint": fp}}
+    path = tmp_path / "results.json"
+    path.write_text(json.dumps(raw))
+    res = exps.read_results(path)
+    assert res.is_current() and res.tables["table1"].as_dicts() == [{"a": "x", "b": 1.5}]
+    path.write_text(json.dumps({**raw, "provenance": {"definition_fingerprint": "0" * 64}}))
+    assert not exps.read_results(path).is_current()
+    path.write_text(json.dumps({**raw, "done": False}))
+    with pytest.raises(ValueError, match="unfinished"):
+        exps.read_results(path)
+    path.write_text(json.dumps({"tables": {}}))
+    with pytest.raises(ValueError, match="lacks"):
+        exps.read_results(path)
+    with pytest.raises(FileNotFoundError, match="make experiments"):
+        exps.read_results(tmp_path / "nope.json")

@@ -156,3 +156,20 @@ def test_span_sees_responses_that_peak_inside_the_range():
     std = np.std(facing)  # no reference meshes: the sweep's own spread is the unit
     assert eff.span[0, j] == pytest.approx((facing.max() - facing.min()) / std, rel=1e-12)  # ... the span does not
     assert eff.span[0, j] > 2.0
+
+
+def test_dimension_displacement_hand_computed_and_blind_to_rigid_motion():
+    model = _FakeModel()
+    d = ex.dimension_displacement(model)
+    assert d.shape == (4,)
+    y = model.V[:, 1]
+    # dim 0 scales y by 0.8 at -2 and 1.2 at +2; the best rigid fit of one onto the other is a pure
+    # translation (the centroid), leaving 0.4 |y - mean(y)| per vertex (up to a rotation of ~1e-8 that
+    # the body's small y-z covariance allows)
+    assert d[0] == pytest.approx(np.mean(0.4 * np.abs(y - y.mean())), rel=1e-6)
+    np.testing.assert_allclose(d[1:], 0.0, atol=1e-9)  # a rotation, and two dimensions that do nothing
+    R = np.stack([model.V, model.V * [1.0, 1.1, 1.0]])
+    spread = np.linalg.norm(R - R.mean(axis=0), axis=-1).mean()
+    np.testing.assert_allclose(ex.dimension_displacement(model, dims=(0,), reference_vertices=R), d[0] / spread, rtol=1e-12)
+    with pytest.raises(ValueError, match="dims"):
+        ex.dimension_displacement(model, dims=(4,))

@@ -1,4 +1,4 @@
-"""FeatureExtractor (RIMD and the coordinate baselines of Table 3) and ConditionEncoder."""
+"""FeatureExtractor (RIMD and the coordinate baselines of Table 2) and ConditionEncoder."""
 
 import numpy as np
 import pytest

@@ -126,3 +126,20 @@ def test_generate_conditional_uses_the_condition():
     other = gen.generate(model, 3, seed=1, condition={"shape": "small"})
     np.testing.assert_array_equal(res.latents, other.latents)  # same prior draws
     assert not np.allclose(res.vertices, other.vertices)  # the condition changes the decoding
+
+
+def test_condition_agreement_against_a_loop_and_the_chance_level():
+    coll = _tiny_collection()
+    model = _tiny_model(coll, labels=("shape",))
+    got = gen.condition_agreement(model, coll, "shape", n=5, seed=2)
+    want = []
+    for v in ("large", "small"):
+        res = gen.generate(model, 5, seed=2, condition={"shape": v}, dataset=coll)
+        want.append(np.mean(res.nearest_labels["shape"] == v))
+    np.testing.assert_array_equal(got, want)
+    # unconditioned, each mesh's neighbour has exactly one of the values: the shares sum to 1
+    plain = gen.condition_agreement(model, coll, "shape", n=5, seed=2, conditioned=False)
+    assert plain.sum() == pytest.approx(1.0, abs=1e-12)
+    assert gen.condition_agreement(model, coll, "shape", values=["small"], n=5, seed=2) == pytest.approx(got[1:])
+    with pytest.raises(ValueError, match="no label column"):
+        gen.condition_agreement(model, coll, "motion")

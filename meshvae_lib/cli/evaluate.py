@@ -7,7 +7,7 @@ import json
 
 DESCRIPTION = """\
 Encode every mesh of DATA to its latent mean, decode it, align it rigidly to the original and
-report the mean per-vertex distance (the error of the paper's Table 3), in the mesh's own units.
+report the mean per-vertex distance (the error of the paper's Table 2), in the mesh's own units.
 With --held-out only the meshes held out during training are measured (DATA must then be the
 training collection).
 

@@ -48,7 +48,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.pt", help="checkpoint file to write")
     p.add_argument("--features", choices=("rimd", "aligned", "coords"), default="rimd",
-                   help="what the network sees: RIMD features (the paper), or the baselines of Table 3:"
+                   help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
                    " rigidly aligned or raw vertex coordinates (default: rimd)")
     p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",

@@ -26,14 +26,19 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from meshvae_lib.exploration import exploration_sigma_object
+from meshvae_lib.tolerances import CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN
+
 logger = logging.getLogger(__name__)
 
 #: environment variable that overrides the cache folder.
 CACHE_ENV = "MESHVAE_CACHE"
 
-#: the library folders whose source determines a trained model (the data, geometry and model layers;
-#: not the viewers, the command line or this course layer).
-_CODE_EXCLUDED = ("viewing", "cli", "course")
+#: the parts of meshvae_lib whose source does not determine a trained model: the applications (they
+#: use a model, not train it), the viewers, the command line and this course layer. Everything else,
+#: and all of data_synth, is in the key.
+_CODE_EXCLUDED = ("viewing", "cli", "course", "generation.py", "interpolation.py", "embedding.py",
+                  "exploration.py", "experiments.py", "evaluation.py")
 
 
 @dataclass(frozen=True)
@@ -86,6 +91,41 @@ COURSE_MODELS: dict[str, CourseModelSpec] = {
             minutes=1.0,
             config={"epochs": 1000, "latent_dim": 128, "batch_size": 16, "seed": 0},
         ),
+        CourseModelSpec(
+            name="plain-bodies",
+            lesson="06_conditional_vae",
+            collection="dyna",
+            resolution=1500,
+            description="5 bodies x 7 motions x 6 frames, 1,464 vertices, all meshes; the library's defaults, latent 16",
+            minutes=0.2,
+            holdout_every=0,
+            config={"epochs": 1000, "latent_dim": 16, "batch_size": 32, "seed": 0},
+        ),
+        CourseModelSpec(
+            name="conditional-bodies",
+            lesson="06_conditional_vae",
+            collection="dyna",
+            resolution=1500,
+            description="the same collection, conditioned on shape and motion; alpha 1e3, a hidden layer of 256, 1000 epochs",
+            minutes=3.0,
+            labels=("shape", "motion"),
+            holdout_every=0,
+            config={"epochs": 1000, "latent_dim": 16, "batch_size": 32, "alpha": CONDITIONAL_ALPHA,
+                    "hidden": CONDITIONAL_HIDDEN, "seed": 0},
+        ),
+        CourseModelSpec(
+            name="exploration-body",
+            lesson="08_exploration",
+            collection="scape",
+            resolution=2000,
+            description="one body in 71 poses, 1,960 vertices, all meshes; graded sigma_object (sibling form), alpha 1e3, "
+                        "a hidden layer of 256, 1000 epochs",
+            minutes=2.0,
+            holdout_every=0,
+            config={"epochs": 1000, "latent_dim": 16, "batch_size": 16, "alpha": EMBEDDING_ALPHA,
+                    "hidden": EMBEDDING_HIDDEN, "sigma_object": tuple(float(s) for s in exploration_sigma_object(16)),
+                    "prior_form": "sibling", "seed": 0},
+        ),
     )
 }
 
@@ -99,8 +139,8 @@ def cache_dir() -> Path:
 
 
 def code_fingerprint() -> str:
-    """sha256 of the source files of ``data_synth`` and of ``meshvae_lib`` without its viewing,
-    command-line and course folders (their relative paths and bytes, in sorted order)."""
+    """sha256 of the source files of ``data_synth`` and of the ``meshvae_lib`` modules that make a
+    trained model (not ``_CODE_EXCLUDED``): their relative paths and bytes, in sorted order."""
     import data_synth
     import meshvae_lib
 
