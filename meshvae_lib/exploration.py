@@ -24,7 +24,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.alignment import rigid_align, rigid_transform
+from meshvae_lib.alignment import rigid_transform
+from meshvae_lib.evaluation import per_vertex_error
 
 __all__ = [
     "exploration_sigma_object",
@@ -379,10 +380,9 @@ def dimension_displacement(model, dims: Sequence[int] | None = None, base=None,
     Z[np.arange(len(dims)), 0, dims] = lo
     Z[np.arange(len(dims)), 1, dims] = hi
     V = np.asarray(model.decode_latent(Z.reshape(-1, D)), dtype=np.float64).reshape(len(dims), 2, -1, 3)
-    A = rigid_align(V[:, 0], V[:, 1])
-    dist = np.linalg.norm(A - V[:, 1], axis=-1).mean(axis=-1)
+    dist = per_vertex_error(V[:, 0], V[:, 1])
     if reference_vertices is not None:
         R = np.asarray(reference_vertices, dtype=np.float64)
-        spread = float(np.linalg.norm(R - R.mean(axis=0), axis=-1).mean())
+        spread = float(per_vertex_error(R, np.broadcast_to(R.mean(axis=0), R.shape), align=False).mean())
         dist = dist / (spread if spread > 0 else 1.0)
     return dist

@@ -24,6 +24,12 @@ COMMANDS = (
 )
 
 
+def add_allow_degenerate(parser: argparse.ArgumentParser) -> None:
+    """The ``--allow-degenerate`` flag of every command that reads meshes (``read_collection``)."""
+    parser.add_argument("--allow-degenerate", action="store_true",
+                        help="accept zero-area faces (they get the fallback cotangent weight)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="meshvae",

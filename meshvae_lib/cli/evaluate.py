@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from . import add_allow_degenerate
+
 DESCRIPTION = """\
 Encode every mesh of DATA to its latent mean, decode it, align it rigidly to the original and
 report the mean per-vertex distance (the error of the paper's Table 2), in the mesh's own units.
@@ -42,8 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         " not held out (no value), or all meshes of the collection TRAIN")
     p.add_argument("--pca-components", type=int, default=None, metavar="K",
                    help="principal components of the PCA baseline (default: all the training meshes span)")
-    p.add_argument("--allow-degenerate", action="store_true",
-                   help="accept zero-area faces (they get the fallback cotangent weight)")
+    add_allow_degenerate(p)
     p.set_defaults(func=run)
     return p
 

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import add_allow_degenerate
+
 logger = logging.getLogger(__name__)
 
 DESCRIPTION = """\
@@ -42,8 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    "with the same connectivity")
     p.add_argument("--layout", choices=("paper", "compact"), default="paper",
                    help="feature layout (default: paper)")
-    p.add_argument("--allow-degenerate", action="store_true",
-                   help="accept zero-area faces (they get the fallback cotangent weight)")
+    add_allow_degenerate(p)
     p.set_defaults(func=run)
     return p
 

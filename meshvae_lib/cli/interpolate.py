@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import add_allow_degenerate
+
 DESCRIPTION = """\
 Encode meshes A and B to their latent means, interpolate linearly in the latent space and decode
 every step (paper Sec. 5, "Interpolation"). A and B are mesh files (OBJ/PLY/OFF, same connectivity
@@ -29,8 +31,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=10, metavar="S", help="meshes in the sequence, ends included (default 10)")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help=".npz file or folder for OBJ files")
     p.add_argument("--data", default=None, metavar="DATA", help="collection that A and B index into")
-    p.add_argument("--allow-degenerate", action="store_true",
-                   help="accept zero-area faces (they get the fallback cotangent weight)")
+    add_allow_degenerate(p)
     p.set_defaults(func=run)
     return p
 

@@ -6,6 +6,7 @@ import argparse
 import logging
 
 from ..tolerances import DEFAULT_ALPHA, DEFAULT_LATENT
+from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)
 
@@ -78,8 +79,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
     p.add_argument("--device", default="auto", help="auto (GPU when available), cpu, cuda, ... (default auto)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    p.add_argument("--allow-degenerate", action="store_true",
-                   help="accept zero-area faces (they get the fallback cotangent weight)")
+    add_allow_degenerate(p)
     p.set_defaults(func=run)
     return p
 

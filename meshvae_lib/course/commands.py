@@ -130,10 +130,11 @@ def _cmd_models(args) -> int:
     total = time.perf_counter()
     for name in names:
         start = time.perf_counter()
-        was_cached = cm.is_cached(name) and not args.rebuild
+        path = cm.cache_path(name)  # the key hashes the library's source: compute it once per model
+        was_cached = path.is_file() and not args.rebuild
         cm.course_model(name, progress=not args.no_progress, rebuild=args.rebuild)
         what = "cached" if was_cached else f"built in {time.perf_counter() - start:.0f} s"
-        print(f"{name}: {what} ({cm.cache_path(name)})", flush=True)
+        print(f"{name}: {what} ({path})", flush=True)
     print(f"{len(names)} course model(s) ready in {time.perf_counter() - total:.0f} s")
     return 0
 
