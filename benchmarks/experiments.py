@@ -9,8 +9,8 @@ the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
   ``meshvae_lib.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
-  their nearest training meshes), ``interpolation_meshes.png`` (Fig. 6), ``exploration_level1.png``
-  and ``exploration_level2.png`` (Fig. 9);
+  their nearest training meshes), ``interpolation_meshes.png`` (Fig. 4), ``exploration_level1.png``
+  and ``exploration_level2.png`` (Fig. 8);
 - ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
 
 One experiment failing does not stop the others; the exit code is 1 if any failed.

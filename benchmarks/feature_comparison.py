@@ -1,4 +1,4 @@
-"""RIMD against aligned and raw vertex coordinates and linear PCA: the experiment of the paper's Table 2/3.
+"""RIMD against aligned and raw vertex coordinates and linear PCA: the experiment of the paper's Table 2.
 
 The same mesh VAE (library defaults unless told otherwise) is trained on three inputs of each
 collection: raw 3D coordinates, coordinates after rigidly aligning every mesh to the reference, and

@@ -1,4 +1,4 @@
-"""How well a mesh VAE reconstructs meshes: the per-vertex position error of the paper's Tables 2-4.
+"""How well a mesh VAE reconstructs meshes: the per-vertex position error of the paper's Tables 1-3.
 
 The error of a reconstructed mesh is the mean Euclidean distance between its vertices and the true
 ones, after rigidly aligning the reconstruction to the truth (the RIMD feature carries no global

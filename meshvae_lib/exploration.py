@@ -1,4 +1,4 @@
-"""Synthesis-based exploration of the shape space (paper Sec. 5.5, Fig. 9).
+"""Synthesis-based exploration of the shape space (paper Sec. 5.5, Fig. 8).
 
 The paper trains the extended mesh VAE on SCAPE with ``sigma_object = (0.1, 0.1, 0.5, 0.5, 1, ...)``
 so that the first dimensions capture the dominant deformations, then browses the latent space in
@@ -90,7 +90,7 @@ def latent_grid(base, dims: Sequence[int] = (0, 1), values_a=None, values_b=None
 
 @dataclass
 class ExplorationGrid:
-    """Decoded meshes on a latent grid (one level of the paper's Fig. 9).
+    """Decoded meshes on a latent grid (one level of the paper's Fig. 8).
 
     Attributes
     ----------
@@ -109,7 +109,7 @@ class ExplorationGrid:
 
 def explore(model, dims: Sequence[int] = (0, 1), base=None, n: int = 5,
             value_range=tol.EXPLORATION_RANGE) -> ExplorationGrid:
-    """Decode an ``n x n`` grid over two latent dimensions (paper Fig. 9).
+    """Decode an ``n x n`` grid over two latent dimensions (paper Fig. 8).
 
     Parameters
     ----------
@@ -185,7 +185,7 @@ def humanoid_regions(V_rest, up: int = 1, left: int = 0, foot_fraction: float = 
 
 
 def measure_humanoid(V, regions: dict) -> dict:
-    """What the paper reads off Fig. 9, as numbers, for every mesh.
+    """What the paper reads off Fig. 8, as numbers, for every mesh.
 
     - ``height``: extent along the up axis (standing vs squatting);
     - ``support``: mean height of the right foot minus that of the left foot, over the body

@@ -95,7 +95,7 @@ def rimd_feature_rows(reference, vertices, faces) -> np.ndarray:
 
 @dataclass
 class GenerationResult:
-    """New meshes and their nearest training meshes (paper Fig. 4 and 5).
+    """New meshes and their nearest training meshes (paper Fig. 2 and 3).
 
     Attributes
     ----------

@@ -1,4 +1,4 @@
-"""Mesh interpolation (paper Sec. 4.5 and 5.3, Fig. 6) and numbers that tell plausible from implausible.
+"""Mesh interpolation (paper Sec. 4.5 and 5.3, Fig. 4) and numbers that tell plausible from implausible.
 
 Three ways to go from mesh A to mesh B in ``n_steps`` steps:
 
@@ -6,7 +6,7 @@ Three ways to go from mesh A to mesh B in ``n_steps`` steps:
   latent vectors, decode every step (``interpolate_latent``; ``interpolate_generated`` starts from
   two latent vectors, e.g. two generated shapes);
 - **RIMD**: step linearly between the two RIMD feature vectors and reconstruct every step
-  (``interpolate_features``; the paper's first row of Fig. 6, which shows self-intersections);
+  (``interpolate_features``; the paper's first row of Fig. 4, which shows self-intersections);
 - **coordinates**: step linearly between the vertex positions (``interpolate_coordinates``; B is
   first rigidly aligned to A, otherwise a turn would shrink the body through its middle).
 
@@ -39,6 +39,7 @@ __all__ = [
     "interpolate_coordinates",
     "interpolate_features",
     "interpolate_latent",
+    "LatentPath",
     "interpolate_generated",
     "edge_lengths",
     "edge_length_distortion",
@@ -100,7 +101,7 @@ def interpolate_coordinates(V_a, V_b, n_steps: int, align: bool = True) -> np.nd
 
 
 def interpolate_features(f_a, f_b, n_steps: int, reconstruct: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """Direct linear interpolation of RIMD features (the paper's Fig. 6, first row).
+    """Direct linear interpolation of RIMD features (the paper's Fig. 4, first row).
 
     Parameters
     ----------
@@ -153,7 +154,7 @@ def interpolate_latent(
 
 
 def interpolate_generated(decode: Callable, z_a, z_b, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """Interpolation between two latent vectors (e.g. two generated shapes, paper Fig. 8a).
+    """Interpolation between two latent vectors (e.g. two generated shapes, paper Fig. 6a).
 
     Returns
     -------
@@ -164,6 +165,31 @@ def interpolate_generated(decode: Callable, z_a, z_b, n_steps: int) -> tuple[np.
     if z.ndim != 2:
         raise ValueError(f"z_a and z_b must be (latent_dim,) vectors, got {np.shape(z_a)}")
     return z, _to_numpy(decode(z))
+
+
+class LatentPath:
+    """The straight latent path between two codes, decoded on demand: ``path(t)`` is the mesh at
+    ``z(t) = (1 - t) z_a + t z_b`` (for a slider, e.g. ``InterpolationSlider(..., interpolate=path)``).
+
+    decode : callable ``(latent,) -> (n_vertices, 3)`` (e.g. ``MeshVAEModel.decode_latent``);
+    z_a, z_b : (latent,) float, the two ends (t = 0 and t = 1).
+    """
+
+    def __init__(self, decode: Callable, z_a, z_b):
+        if not callable(decode):
+            raise ValueError(f"decode must be callable, got {type(decode).__name__}")
+        self.z_a, self.z_b = _to_numpy(z_a), _to_numpy(z_b)
+        if self.z_a.ndim != 1 or self.z_a.shape != self.z_b.shape:
+            raise ValueError(f"z_a and z_b must be (latent_dim,) vectors of one size, got {self.z_a.shape}, {self.z_b.shape}")
+        self.decode = decode
+
+    def latent(self, t: float) -> np.ndarray:
+        """z(t), (latent,) float64."""
+        return (1.0 - float(t)) * self.z_a + float(t) * self.z_b
+
+    def __call__(self, t: float) -> np.ndarray:
+        """The decoded mesh at t, (n_vertices, 3)."""
+        return _to_numpy(self.decode(self.latent(t)))
 
 
 # --------------------------------------------------------------------------------------------

@@ -49,6 +49,21 @@ def test_every_registered_model_is_well_formed():
         cm.get_spec("no-such-model")
 
 
+def test_every_model_is_used_by_its_lesson_and_lessons_05_to_08_use_course_models():
+    import re
+
+    sources = {nb.stem: nb.read_text() for nb in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")}
+    for name, spec in cm.COURSE_MODELS.items():
+        prefix = name.rsplit("-", 1)[0]
+        used = f'\\"{name}\\"' in sources[spec.lesson] or (   # the name as a string in the lesson's code
+            name.rsplit("-", 1)[-1].isdigit() and f'course_model(f\\"{prefix}-{{' in sources[spec.lesson])
+        assert used, f"{name} is registered for {spec.lesson}, which does not load it"
+    for lesson, text in sources.items():
+        if lesson[:2] in ("05", "06", "07", "08"):
+            assert "course_model(" in text, lesson
+            assert not re.search(r"\.fit\(|train_vae\(", text), f"{lesson} trains a model instead of loading one"
+
+
 def test_the_key_changes_with_anything_that_determines_the_model(monkeypatch):
     key = cm.model_key(TINY)
     assert key == cm.model_key(dataclasses.replace(TINY)) and len(key) == 64

@@ -208,3 +208,17 @@ def test_batch_and_implausibility_table(rng):
     assert rows[0]["method"] == "a" and rows[0]["max edge distortion"] == pytest.approx(0.1)
     md = table.to_markdown()
     assert md.count("\n") == 3 and "| a |" in md
+
+
+def test_latent_path_decodes_the_straight_blend():
+    from meshvae_lib.interpolation import LatentPath
+
+    seen = []
+    path = LatentPath(lambda z: (seen.append(z), np.tile(z[:1], (4, 3)))[1], np.array([0.0, 2.0]), np.array([1.0, 0.0]))
+    np.testing.assert_allclose(path.latent(0.25), [0.25, 1.5], atol=1e-15)
+    V = path(0.5)
+    assert V.shape == (4, 3) and np.allclose(V, 0.5) and np.allclose(seen[-1], [0.5, 1.0])
+    np.testing.assert_array_equal(path.latent(0.0), [0.0, 2.0])
+    np.testing.assert_array_equal(path.latent(1.0), [1.0, 0.0])
+    with pytest.raises(ValueError, match="one size"):
+        LatentPath(lambda z: z, np.zeros(2), np.zeros(3))

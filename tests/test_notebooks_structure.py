@@ -115,3 +115,32 @@ def test_every_ignored_output_is_checked_by_an_assertion(nb):
             assert i + 1 < len(cells) and "assert" in _text(cells[i + 1]), f"no self-check after:\n{src}"
         else:
             assert re.search(r"^\s*assert ", src, flags=re.MULTILINE), f"ignored output without an assertion:\n{src}"
+
+
+def _definitions(source: str) -> list[str]:
+    """Names of the functions, classes and lambdas a cell defines (IPython magics blanked out)."""
+    import ast
+
+    lines = ["" if line.lstrip().startswith(("%", "!")) else line for line in source.splitlines()]
+    found = []
+    for node in ast.walk(ast.parse("\n".join(lines))):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            found.append(node.name)
+        elif isinstance(node, ast.Lambda):
+            found.append("lambda")
+    return found
+
+
+def test_defines_no_function_or_class_outside_exercise_solutions(nb):
+    """Notebooks call the library: helpers live there, where they are tested (exercise solutions,
+    which the student writes, are exempt)."""
+    for cell in nb.cells:
+        src = _text(cell)
+        if cell.cell_type != "code" or BEGIN_SOLUTION in src:
+            continue
+        assert not _definitions(src), f"defines {_definitions(src)}; move it to the library:\n{src}"
+
+
+def test_the_definition_check_sees_definitions():
+    assert _definitions("def f(x):\n    return x\nclass A: pass\ng = lambda y: y") == ["f", "A", "lambda"]
+    assert _definitions("%matplotlib inline\n!ls {x}\ny = sorted(z, key=len)") == []

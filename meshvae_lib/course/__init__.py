@@ -1,2 +1,2 @@
 """The course layer: notebook tooling (:mod:`.notebooks`), the course's trained models
-(:mod:`.models`) and the ``python -m meshvae_lib.course`` commands (:mod:`.commands`)."""
+(:mod:`.models`), stable printing of round-off (:mod:`.display`) and the ``python -m meshvae_lib.course`` commands (:mod:`.commands`)."""

@@ -26,8 +26,10 @@ import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
+from meshvae_lib.embedding import embedding_sigma_object
 from meshvae_lib.exploration import exploration_sigma_object
-from meshvae_lib.tolerances import CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN
+from meshvae_lib.tolerances import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN,
+                                    EMBEDDING_SEEDS)
 
 logger = logging.getLogger(__name__)
 
@@ -91,6 +93,28 @@ _PLAIN_BODIES = CourseModelSpec(
     config={"epochs": 1000, "latent_dim": 16, "batch_size": 32, "seed": 0},
 )
 
+#: 07's models: the sigma_object prior (0.1 for dims 1-2, 1 for the rest) on 06's collection, once
+#: per seed of the embedding experiment (the map depends on the run), and the two ablations.
+_EMBEDDING_BODIES = replace(
+    _PLAIN_BODIES,
+    name="embedding-bodies-0",
+    lesson="07_sigma_object_embeddings",
+    description="06's collection; sigma_object 0.1 for dims 1-2 (sibling form), alpha 1e3, a hidden layer of 256, "
+                "latent 128, 153 epochs (1,000 Adam steps)",
+    minutes=0.5,
+    config={"epochs": 153, "latent_dim": 128, "batch_size": 32, "alpha": EMBEDDING_ALPHA, "hidden": EMBEDDING_HIDDEN,
+            "sigma_object": tuple(float(s) for s in embedding_sigma_object(128)), "prior_form": "sibling", "seed": 0},
+)
+EMBEDDING_MODELS = tuple(f"embedding-bodies-{seed}" for seed in EMBEDDING_SEEDS)
+_EMBEDDING_ABLATIONS = (
+    replace(_EMBEDDING_BODIES, name="embedding-bodies-exact-kl",
+            description="as embedding-bodies-0 with the exact KL of the sigma_object prior",
+            config={**_EMBEDDING_BODIES.config, "prior_form": "exact"}),
+    replace(_EMBEDDING_BODIES, name="embedding-bodies-alpha1e6",
+            description="as embedding-bodies-0 with alpha 1e6 and no hidden layer", minutes=0.3,
+            config={**_EMBEDDING_BODIES.config, "alpha": 1e6, "hidden": ()}),
+)
+
 COURSE_MODELS: dict[str, CourseModelSpec] = {
     spec.name: spec
     for spec in (
@@ -112,6 +136,9 @@ COURSE_MODELS: dict[str, CourseModelSpec] = {
             labels=("shape", "motion"),
             config={**_PLAIN_BODIES.config, "alpha": CONDITIONAL_ALPHA, "hidden": CONDITIONAL_HIDDEN},
         ),
+        *(replace(_EMBEDDING_BODIES, name=f"embedding-bodies-{seed}", config={**_EMBEDDING_BODIES.config, "seed": seed},
+                  description=_EMBEDDING_BODIES.description + f", seed {seed}") for seed in EMBEDDING_SEEDS),
+        *_EMBEDDING_ABLATIONS,
         CourseModelSpec(
             name="exploration-body",
             lesson="08_exploration",

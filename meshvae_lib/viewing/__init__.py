@@ -14,6 +14,7 @@ module                      public names
                             ``label_colors``, ``colorbar_html``, ``legend_html``
 ``render``                  ``render_mesh``, ``render_mesh_grid``, ``figure_to_png``
 ``fallback``                ``resolve_mode``, ``ImageView``
+``gallery``                 ``gallery_indices``, ``mesh_caption``, ``angular_stripes``
 ``viewer``                  ``MeshViewer``
 ``widgets``                 ``FramePlayer``, ``LatentExplorer``, ``InterpolationSlider``
 ==========================  =====================================================================
@@ -36,6 +37,9 @@ _NAMES = {
     "label_colors": "colors",
     "colorbar_html": "colors",
     "legend_html": "colors",
+    "gallery_indices": "gallery",
+    "mesh_caption": "gallery",
+    "angular_stripes": "gallery",
     "render_mesh": "render",
     "render_mesh_grid": "render",
     "figure_to_png": "render",

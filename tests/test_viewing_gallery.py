@@ -1,0 +1,49 @@
+"""Gallery selection and captions (notebook 00), and the round-off printer of the lessons."""
+
+import numpy as np
+import pytest
+
+from meshvae_lib.course.display import roundoff
+from meshvae_lib.viewing.gallery import angular_stripes, gallery_indices, mesh_caption
+
+
+def test_evenly_spaced_without_groups():
+    V = np.zeros((11, 4, 3))
+    assert gallery_indices(V, 3).tolist() == [0, 5, 10]
+    assert gallery_indices(V[:2], 5).tolist() == [0, 1]   # never the same mesh twice
+
+
+def test_the_most_deformed_mesh_of_each_group_in_order_of_appearance():
+    V = np.zeros((6, 2, 3))
+    V[:, :, 0] = np.array([0.0, 3.0, 1.0, 0.5, 2.0, 0.1])[:, None]   # distance of each mesh from mesh 0
+    groups = np.array(["b", "b", "a", "a", "c", "c"])
+    assert gallery_indices(V, 8, groups).tolist() == [1, 2, 4]
+    assert gallery_indices(V, 2, groups).tolist() == [1, 2]
+    with pytest.raises(ValueError, match=r"one label per mesh \(6\), got shape \(5,\)"):
+        gallery_indices(V, 2, groups[:5])
+    with pytest.raises(ValueError, match="n_panels must be >= 1, got 0"):
+        gallery_indices(V, 0)
+
+
+def test_captions_show_categories_numbers_with_units_and_the_frame_when_little_else():
+    labels = {"motion": np.array(["jumping_jacks", "run"]), "frame": np.array([3, 4])}
+    assert mesh_caption(labels, 0, "m0") == "jumping jacks\nframe 3"
+    labels = {"bend_deg": np.array([30, 45]), "wind_pct": np.array([10, 20])}
+    assert mesh_caption(labels, 1, "m1") == "bend 45°, wind 20%"
+    assert mesh_caption({}, 0, "pose_007") == "pose_007"
+
+
+def test_stripes_alternate_around_the_axis():
+    angles = np.linspace(-np.pi + 0.1, np.pi - 0.1, 8)   # one vertex per band of 8
+    rest = np.stack([np.zeros(8), np.cos(angles), np.sin(angles)], axis=1)
+    c = angular_stripes(rest, n_stripes=8, colors=((0, 0, 0), (1, 1, 1)))
+    assert c[:, 0].tolist() == [0, 1, 0, 1, 0, 1, 0, 1]
+    with pytest.raises(ValueError, match="even number >= 2, got 3"):
+        angular_stripes(rest, 3)
+
+
+def test_roundoff_prints_a_bound_below_it_and_digits_above():
+    assert roundoff(3e-16) == "< 1e-10" and roundoff(-2e-12, 1e-11) == "< 1e-11"
+    assert roundoff(3.24e-4) == "3.2e-04"
+    with pytest.raises(ValueError, match="below must be > 0, got 0"):
+        roundoff(1.0, 0)
