@@ -193,3 +193,137 @@ def coalesce_streams(outputs: list) -> list:
         else:
             merged.append(out)
     return merged
+
+
+#: the trivial answers tried for every exercise (see :func:`trivial_answer_notebook`).
+TRIVIAL_ANSWERS = ("unchanged", "None", "zeros")
+TRIVIAL_MARKER = "TRIVIAL-ANSWER-OUTCOMES"
+
+
+def solution_names(source: str) -> list[str]:
+    """The names a solution block binds at top level (its answer), in order of first binding.
+
+    source : a code cell's source with ``### BEGIN SOLUTION`` ... ``### END SOLUTION``. Plain and
+    augmented assignments, ``for`` targets and ``with ... as`` names count; names bound inside
+    functions do not (a function defined by the solution counts by its own name).
+    """
+    import ast
+
+    names: list[str] = []
+    for match in _SOLUTION_BLOCK.finditer(source):
+        block = match.group(0)
+        lines = [line for line in block.splitlines() if not line.lstrip().startswith(("%", "!"))]
+        tree = ast.parse("\n".join(line[len(match.group(1)):] for line in lines))
+        for node in tree.body:
+            targets = []
+            if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            elif isinstance(node, (ast.For, ast.With)):
+                targets = [node.target] if isinstance(node, ast.For) else [i.optional_vars for i in node.items if i.optional_vars]
+            elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                names.append(node.name)
+            for t in targets:
+                for n in ast.walk(t):
+                    if isinstance(n, ast.Name) and n.id not in names:
+                        names.append(n.id)
+    return names
+
+
+_TRIVIAL_CELL = '''\
+import json as _tj, numpy as _tnp
+_t_names, _t_check = {names!r}, {check!r}
+_t_real = {{n: globals()[n] for n in _t_names if n in globals()}}
+def _t_zero(v):
+    if isinstance(v, bool):
+        return False
+    if isinstance(v, (int, float, complex)):
+        return type(v)(0)
+    if isinstance(v, _tnp.ndarray):
+        return _tnp.zeros_like(v)
+    if hasattr(v, "zero_") and hasattr(v, "clone"):
+        return v.clone().zero_()
+    if isinstance(v, (str, list, tuple, dict, set)):
+        return type(v)()
+    return None
+_t_outcomes = {{}}
+for _t_answer in {answers!r}:
+    for _t_n in _t_names:
+        globals().pop(_t_n, None)
+        if _t_answer == "unchanged" and _t_n in _t_before:
+            globals()[_t_n] = _t_before[_t_n]
+        elif _t_answer == "None":
+            globals()[_t_n] = None
+        elif _t_answer == "zeros":
+            globals()[_t_n] = _t_zero(_t_real.get(_t_n))
+    try:
+        exec(_t_check, globals())
+        _t_outcomes[_t_answer] = "passed"
+    except BaseException as _t_e:
+        _t_outcomes[_t_answer] = type(_t_e).__name__
+for _t_n in _t_names:
+    globals().pop(_t_n, None)
+globals().update(_t_real)
+print({marker!r}, _tj.dumps(_t_outcomes))
+'''
+
+
+def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS):
+    """A copy of ``nb`` that tries trivial answers on every exercise's self-check.
+
+    For each solution cell (``### BEGIN SOLUTION``) followed by its self-check (the next code
+    cell), a cell before the solution remembers the answer names' starting values, and a cell
+    after it (a) sets the names the solution binds (:func:`solution_names`) to each trivial
+    answer in turn -- ``"unchanged"``: their values before the solution (undefined if they had
+    none), ``"None"``, ``"zeros"``: a zero of the real answer's type and shape (0, zeros_like,
+    an empty container; None for other objects) --, (b) runs the self-check's source on it and
+    records whether it raised, then (c) restores the real answers, so that the rest of the
+    notebook runs as usual. This is what a student copy (:func:`student_notebook`) with that
+    answer in place of the solution would do. Executing the result prints one line per
+    exercise, ``TRIVIAL-ANSWER-OUTCOMES {"unchanged": "AssertionError", ...}``
+    (:func:`trivial_answer_outcomes` reads them).
+
+    Returns (notebook, exercises): ``exercises`` lists, per exercise, ``(solution cell index in
+    nb, names)``.
+    """
+    import copy
+
+    import nbformat
+
+    src = copy.deepcopy(nb)
+    cells, exercises = [], []
+    code_after = {}
+    code_idx = [i for i, c in enumerate(src.cells) if c.cell_type == "code"]
+    for a, b in zip(code_idx, code_idx[1:]):
+        code_after[a] = b
+    for i, cell in enumerate(src.cells):
+        is_solution = cell.cell_type == "code" and BEGIN_SOLUTION in cell.source
+        if not is_solution:
+            cells.append(cell)
+            continue
+        if i not in code_after:
+            raise ValueError(f"the solution in cell {i} has no self-check cell after it")
+        names = solution_names(cell.source)
+        exercises.append((i, names))
+        cells.append(nbformat.v4.new_code_cell(f"_t_before = {{n: globals()[n] for n in {names!r} if n in globals()}}"))
+        cells.append(cell)
+        check = src.cells[code_after[i]].source
+        cells.append(nbformat.v4.new_code_cell(_TRIVIAL_CELL.format(names=names, check=check, answers=tuple(answers),
+                                                                  marker=TRIVIAL_MARKER)))
+    src.cells = cells
+    return src, exercises
+
+
+def trivial_answer_outcomes(executed_nb) -> list[dict]:
+    """The outcome lines of an executed :func:`trivial_answer_notebook`, in exercise order:
+    one dict per exercise, answer -> the exception the self-check raised, or ``"passed"``."""
+    import json
+
+    found = []
+    for cell in executed_nb.cells:
+        if cell.cell_type != "code":
+            continue
+        for out in cell.get("outputs", []):
+            for line in out.get("text", "").splitlines():
+                if line.startswith(TRIVIAL_MARKER):
+                    found.append(json.loads(line[len(TRIVIAL_MARKER):]))
+    return found
