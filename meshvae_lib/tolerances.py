@@ -71,7 +71,7 @@ TSNE_PERPLEXITY = 30.0
 #: t-SNE inputs are reduced to this many principal components first.
 TSNE_PCA_DIMS = 50
 
-# --- applications: exploration (paper Sec. 5.5, Fig. 9) -------------------------------------
+# --- applications: exploration (paper Sec. 5.5, Fig. 8) -------------------------------------
 #: prior deviations of the exploration model: first two, next two, the rest.
 EXPLORATION_SIGMA_OBJECT = (0.1, 0.1, 0.5, 0.5)
 #: browsing range of each explored latent dimension.

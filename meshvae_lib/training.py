@@ -27,7 +27,7 @@ __all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout
            "pad_sigma_object", "pca_network", "INIT_MODES"]
 
 #: how :func:`train_vae` initialises a new network.
-INIT_MODES = ("pca", "random")
+from .model.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
 
 logger = logging.getLogger(__name__)
 
@@ -109,7 +109,7 @@ class TrainConfig:
     device: str = "auto"
     progress: bool = True
     eval_every: int = 10
-    init: str = "pca"
+    init: str = DEFAULT_INIT
     feature_range: float | None = None
     early_stopping: bool | None = None
     validation_every: int = VALIDATION_EVERY

@@ -99,3 +99,25 @@ def test_bad_input_gives_one_line_errors(tmp_path, data, capsys):
         assert main(argv) == 1, argv
         err = capsys.readouterr().err.strip().splitlines()
         assert message in err[-1] and err[-1].startswith("meshvae "), (argv, err)
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["synth", "--list"], ["features", "--help"], ["reconstruct", "--help"],
+                                  ["train", "--help"], ["evaluate", "--help"], ["generate", "--help"],
+                                  ["interpolate", "--help"], ["--version"]])
+def test_commands_that_need_no_model_do_not_import_torch(argv):
+    """Start-up time: torch's import alone takes seconds on a small machine (benchmarks/bench_cli_startup.py)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom meshvae_lib.cli import main\ntry:\n    main(%r)\nexcept SystemExit:\n    pass\n"
+            "print('TORCH', 'torch' in sys.modules)" % (argv,))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip().splitlines()[-1] == "TORCH False", out[-500:]
+
+
+def test_version(capsys):
+    from meshvae_lib import __version__
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"meshvae {__version__}"

@@ -36,6 +36,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Mesh variational autoencoders (Tan et al., CVPR 2018): RIMD features, "
         "reconstruction, training and applications on your own deforming meshes.",
     )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:

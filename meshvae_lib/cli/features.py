@@ -32,6 +32,8 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
+    from ..model.defaults import LAYOUTS
+
     p = subparsers.add_parser(
         "features", help="RIMD features of a mesh collection", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -42,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="reference mesh: an index into the collection (default 0, the first mesh; "
                    "negative counts from the end), a mesh name from the collection, or a mesh file "
                    "with the same connectivity")
-    p.add_argument("--layout", choices=("paper", "compact"), default="paper",
+    p.add_argument("--layout", choices=LAYOUTS, default="paper",
                    help="feature layout (default: paper)")
     add_allow_degenerate(p)
     p.set_defaults(func=run)

@@ -28,15 +28,17 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
+    from ..model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+
     p = subparsers.add_parser(
         "reconstruct", help="meshes from RIMD features", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("features", metavar="FEATS.npz", help="feature file from `meshvae features`")
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help="folder to write OBJ files to, or an .npz collection file")
-    p.add_argument("--method", choices=("exact", "paper"), default="exact",
+    p.add_argument("--method", choices=RECONSTRUCTION_METHODS, default="exact",
                    help="position solve (default: exact)")
-    p.add_argument("--rotations", choices=("global", "bfs"), default="global",
+    p.add_argument("--rotations", choices=ROTATION_RECOVERY, default="global",
                    help="rotation recovery: global least squares over all edges (default, robust "
                    "to noise) or the reference's spanning-tree walk")
     p.add_argument("--iterations", type=int, default=0, metavar="N",

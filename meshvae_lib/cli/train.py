@@ -41,20 +41,20 @@ def _floats(text: str) -> list[float]:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from ..training import INIT_MODES, TrainConfig
+    from ..model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
+    from ..tolerances import DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LR
 
-    d = TrainConfig()
     p = subparsers.add_parser("train", help="train a mesh VAE and save a checkpoint", description=DESCRIPTION,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
     p.add_argument("-o", "--output", required=True, metavar="MODEL.pt", help="checkpoint file to write")
-    p.add_argument("--features", choices=("rimd", "aligned", "coords"), default="rimd",
+    p.add_argument("--features", choices=FEATURE_KINDS, default="rimd",
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
                    " rigidly aligned or raw vertex coordinates (default: rimd)")
     p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
-                   help=f"training epochs, the most early stopping may choose (default {d.epochs})")
-    p.add_argument("--init", choices=INIT_MODES, default=d.init,
+                   help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS})")
+    p.add_argument("--init", choices=INIT_MODES, default=DEFAULT_INIT,
                    help="pca (default): start from the PCA of the training features (networks without internal"
                         " layers, standard prior, no labels; docs/vae.md); random: PyTorch's initialisation (the paper)")
     p.add_argument("--no-early-stopping", action="store_true",
@@ -63,15 +63,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help=f"weight of the reconstruction term, Eq. 4 (default {DEFAULT_ALPHA:g})")
     p.add_argument("--hidden", type=int, nargs="*", default=None, metavar="H",
                    help="internal layer sizes, outermost first (default: none; see docs/vae.md)")
-    p.add_argument("--batch-size", type=int, default=d.batch_size, metavar="B", help=f"default {d.batch_size}")
-    p.add_argument("--lr", type=float, default=d.lr, help=f"Adam learning rate (default {d.lr:g})")
+    p.add_argument("--batch-size", type=int, default=DEFAULT_BATCH_SIZE, metavar="B", help=f"default {DEFAULT_BATCH_SIZE}")
+    p.add_argument("--lr", type=float, default=DEFAULT_LR, help=f"Adam learning rate (default {DEFAULT_LR:g})")
     p.add_argument("--holdout-every", type=int, default=0, metavar="K",
                    help="hold out every K-th mesh (K >= 2) and report its reconstruction error (default: 0, none)")
     p.add_argument("--labels", nargs="+", default=[], metavar="COLUMN",
                    help="label columns to condition on (conditional mesh VAE, Eq. 5)")
     p.add_argument("--sigma-object", type=_floats, default=None, metavar="V1,V2,...",
                    help="prior deviations of the first latent dimensions (Sec. 4.4); the rest are 1")
-    p.add_argument("--prior-form", choices=("exact", "sibling"), default="exact",
+    p.add_argument("--prior-form", choices=PRIOR_FORMS, default="exact",
                    help="how --sigma-object enters the latent cost: the exact KL (default) or the authors'"
                         " sibling-code formula, which makes the small-sigma dimensions carry the dominant"
                         " variation (for 2D maps and exploration)")
