@@ -2,9 +2,8 @@
 
 Every number with two or more significant digits in a markdown cell (outside formulas, code spans
 and links) must appear in the same notebook's code or outputs -- so a claim can be checked against
-the stored run --, or be the paper's: its sentence says "paper", or the number is in the paper's
-LaTeX source (``../shared/seed``; without it, only the sentence rule applies), or it cites where it
-was measured (``docs/``). Section, figure, table, equation, notebook, exercise and seed numbers are
+the stored run --, or be marked as the paper's (its sentence says "paper"; the paper itself is not in
+the clone), or cite where it was measured (``docs/``). Section, figure, table, equation, notebook, exercise and seed numbers are
 references, not quantities, and are skipped, as are years.
 """
 
@@ -18,8 +17,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
-SEED_DIR = ROOT.parent / "shared" / "seed"
-PAPER = "\n".join(p.read_text() for p in sorted(SEED_DIR.glob("*.txt"))).replace(",", "") if SEED_DIR.is_dir() else ""
 
 NUMBER = re.compile(r"(?<![\w.])(\d{1,3}(?:,\d{3})+|\d+\.\d+|\d+)(?![\w])")
 REFERENCE_BEFORE = re.compile(r"(Sec\.|Secs\.|Section|sections?|notebooks?|Figs?\.|Tables?|Eqs?\.|Equations?|cells?"
@@ -82,8 +79,6 @@ def unsupported_numbers(nb: dict) -> list[str]:
             sentence = md[start:end]
             forms = _forms(token, md[m.end():m.end() + 1] == "%")
             if _appears(forms, visible) or "paper" in sentence.lower() or "docs/" in sentence:
-                continue
-            if PAPER and _appears(forms, PAPER):
                 continue
             bad.append(f"{token}: ...{md[max(0, m.start() - 60):m.end() + 30]}...".replace("\n", " "))
     return bad
