@@ -13,7 +13,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from meshvae_lib.course.notebooks import BEGIN_SOLUTION, END_SOLUTION, student_notebook
+from meshvae_lib.course.notebooks import BEGIN_SOLUTION, END_SOLUTION, student_notebook, without_magics
 
 NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
@@ -121,9 +121,8 @@ def _definitions(source: str) -> list[str]:
     """Names of the functions, classes and lambdas a cell defines (IPython magics blanked out)."""
     import ast
 
-    lines = ["" if line.lstrip().startswith(("%", "!")) else line for line in source.splitlines()]
     found = []
-    for node in ast.walk(ast.parse("\n".join(lines))):
+    for node in ast.walk(ast.parse(without_magics(source))):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
             found.append(node.name)
         elif isinstance(node, ast.Lambda):

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..model.defaults import LAYOUTS
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)
@@ -32,8 +33,6 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from ..model.defaults import LAYOUTS
-
     p = subparsers.add_parser(
         "features", help="RIMD features of a mesh collection", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -7,6 +7,8 @@ import logging
 import sys
 from pathlib import Path
 
+from ..model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+
 logger = logging.getLogger(__name__)
 
 DESCRIPTION = """\
@@ -28,8 +30,6 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from ..model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
-
     p = subparsers.add_parser(
         "reconstruct", help="meshes from RIMD features", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import logging
 
-from ..tolerances import DEFAULT_ALPHA, DEFAULT_LATENT
+from ..model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
+from ..tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)
@@ -41,9 +42,6 @@ def _floats(text: str) -> list[float]:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from ..model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
-    from ..tolerances import DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LR
-
     p = subparsers.add_parser("train", help="train a mesh VAE and save a checkpoint", description=DESCRIPTION,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")

@@ -105,7 +105,6 @@ _EMBEDDING_BODIES = replace(
     config={"epochs": 153, "latent_dim": 128, "batch_size": 32, "alpha": EMBEDDING_ALPHA, "hidden": EMBEDDING_HIDDEN,
             "sigma_object": tuple(float(s) for s in embedding_sigma_object(128)), "prior_form": "sibling", "seed": 0},
 )
-EMBEDDING_MODELS = tuple(f"embedding-bodies-{seed}" for seed in EMBEDDING_SEEDS)
 _EMBEDDING_ABLATIONS = (
     replace(_EMBEDDING_BODIES, name="embedding-bodies-exact-kl",
             description="as embedding-bodies-0 with the exact KL of the sigma_object prior",

@@ -200,6 +200,12 @@ TRIVIAL_ANSWERS = ("unchanged", "None", "zeros")
 TRIVIAL_MARKER = "TRIVIAL-ANSWER-OUTCOMES"
 
 
+def without_magics(source: str) -> str:
+    """A code cell's source with its IPython lines (``%magic``, ``!shell``) blanked, so that ``ast``
+    can parse it; line numbers stay as they are."""
+    return "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in source.splitlines())
+
+
 def solution_names(source: str) -> list[str]:
     """The names a solution block binds at top level (its answer), in order of first binding.
 
@@ -212,8 +218,7 @@ def solution_names(source: str) -> list[str]:
     names: list[str] = []
     for match in _SOLUTION_BLOCK.finditer(source):
         block = match.group(0)
-        lines = [line for line in block.splitlines() if not line.lstrip().startswith(("%", "!"))]
-        tree = ast.parse("\n".join(line[len(match.group(1)):] for line in lines))
+        tree = ast.parse("\n".join(line[len(match.group(1)):] for line in without_magics(block).splitlines()))
         for node in tree.body:
             targets = []
             if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
