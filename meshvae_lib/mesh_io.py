@@ -96,6 +96,23 @@ class MeshCollection:
     def n_vertices(self) -> int:
         return self.vertices.shape[1]
 
+    def subset(self, indices) -> "MeshCollection":
+        """The meshes at ``indices`` (int array-like, or a boolean mask of length ``len(self)``), in
+        that order, with their names and labels; the faces are shared. Indices may repeat."""
+        idx = np.asarray(indices)
+        if idx.dtype == bool:
+            if idx.shape != (len(self),):
+                raise ValueError(f"a boolean mask must have shape ({len(self)},), got {idx.shape}")
+            idx = np.flatnonzero(idx)
+        if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+            raise ValueError(f"indices must be a 1-D array of integers, got dtype {idx.dtype} shape {idx.shape}")
+        if idx.size == 0:
+            raise ValueError("a collection needs at least one mesh, got no indices")
+        if idx.min() < -len(self) or idx.max() >= len(self):
+            raise ValueError(f"indices must lie in [0, {len(self) - 1}], got range [{idx.min()}, {idx.max()}]")
+        return MeshCollection(self.vertices[idx], self.faces, [self.names[i] for i in idx],
+                              {k: v[idx] for k, v in self.labels.items()})
+
 
 def _default_names(n: int) -> list[str]:
     width = max(4, len(str(max(n - 1, 0))))

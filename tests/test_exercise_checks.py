@@ -21,10 +21,12 @@ NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
 
 
-def test_solution_names_are_the_top_level_bindings():
+def test_solution_names_are_the_global_bindings():
     src = ("x = 1\n### BEGIN SOLUTION\na, (b, c) = 1, (2, 3)\nfor i in range(2):\n    inner = i\n"
-           "total += 1\nwith open('f') as fh:\n    pass\ndef helper():\n    hidden = 1\n### END SOLUTION\ny = 2\n")
-    assert solution_names(src) == ["a", "b", "c", "i", "total", "fh", "helper"]
+           "total += 1\nwith open('f') as fh:\n    pass\ndef helper():\n    hidden = 1\n"
+           "sq = [k * k for k in range(3)]\nf = lambda u: u\nif a:\n    late = 2\nimport os.path\n"
+           "### END SOLUTION\ny = 2\n")
+    assert solution_names(src) == ["a", "b", "c", "i", "inner", "total", "fh", "helper", "sq", "f", "late"]
 
 
 def test_the_trivial_answer_notebook_wraps_each_exercise():

@@ -198,3 +198,18 @@ def test_mesh_collection_validates_shapes():
         MeshCollection(np.zeros((4, 3)), np.zeros((1, 3), int))
     with pytest.raises(ValueError, match="2 names for 1 meshes"):
         MeshCollection(np.zeros((1, 4, 3)), np.zeros((1, 3), int), ["a", "b"])
+
+
+def test_collection_subset_keeps_names_labels_and_order(sphere):
+    V, F = sphere
+    verts = np.stack([V + i for i in range(5)])
+    coll = MeshCollection(verts, F, [f"m{i}" for i in range(5)], {"k": np.arange(5) * 10})
+    sub = coll.subset([3, 1, 3])
+    assert sub.names == ["m3", "m1", "m3"] and sub.labels["k"].tolist() == [30, 10, 30]
+    assert np.array_equal(sub.vertices, verts[[3, 1, 3]]) and sub.faces is coll.faces
+    mask = np.array([True, False, False, False, True])
+    assert coll.subset(mask).names == ["m0", "m4"]
+    for bad, msg in (([5], r"\[0, 4\], got range \[5, 5\]"), ([], "at least one"), ([0.5], "integers"),
+                     (np.ones(3, bool), r"shape \(5,\)")):
+        with pytest.raises(ValueError, match=msg):
+            coll.subset(bad)

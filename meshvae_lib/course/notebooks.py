@@ -207,30 +207,39 @@ def without_magics(source: str) -> str:
 
 
 def solution_names(source: str) -> list[str]:
-    """The names a solution block binds at top level (its answer), in order of first binding.
+    """The names a solution block binds in the notebook's global scope (its answer), in order of
+    first binding.
 
-    source : a code cell's source with ``### BEGIN SOLUTION`` ... ``### END SOLUTION``. Plain and
-    augmented assignments, ``for`` targets and ``with ... as`` names count; names bound inside
-    functions do not (a function defined by the solution counts by its own name).
+    source : a code cell's source with ``### BEGIN SOLUTION`` ... ``### END SOLUTION``. Every
+    binding at module scope counts -- assignments, ``for`` targets and ``with ... as`` names, also
+    inside loop, ``if`` and ``with`` bodies --; imports do not (they are tools, not answers), nor
+    names bound inside functions, classes, lambdas and comprehensions (a function or class counts
+    by its own name).
     """
     import ast
 
     names: list[str] = []
+
+    def add(name: str) -> None:
+        if name not in names:
+            names.append(name)
+
+    def visit(node) -> None:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            add(node.name)
+            return
+        if isinstance(node, (ast.Lambda, ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp)):
+            return
+        if isinstance(node, (ast.Import, ast.ImportFrom)):   # tools, not answers: left as imported
+            return
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            add(node.id)
+        for child in ast.iter_child_nodes(node):
+            visit(child)
+
     for match in _SOLUTION_BLOCK.finditer(source):
         block = match.group(0)
-        tree = ast.parse("\n".join(line[len(match.group(1)):] for line in without_magics(block).splitlines()))
-        for node in tree.body:
-            targets = []
-            if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
-                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-            elif isinstance(node, (ast.For, ast.With)):
-                targets = [node.target] if isinstance(node, ast.For) else [i.optional_vars for i in node.items if i.optional_vars]
-            elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
-                names.append(node.name)
-            for t in targets:
-                for n in ast.walk(t):
-                    if isinstance(n, ast.Name) and n.id not in names:
-                        names.append(n.id)
+        visit(ast.parse("\n".join(line[len(match.group(1)):] for line in without_magics(block).splitlines())))
     return names
 
 
