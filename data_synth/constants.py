@@ -66,6 +66,16 @@ DYNA_FRAMES_PER_MOTION = 6
 HAND_DEFAULT_RESOLUTION = 1800
 HAND_BLEND_RADIUS = 0.006
 HAND_SKIN_BLEND_WIDTH = 0.016
+#: the flag's pole (scenery for renderings, not part of the mesh): radius, bottom and top, in the
+#: flag's units (the sheet is 1 high, from y = 0 to 1)
+FLAG_POLE_RADIUS = 0.02
+FLAG_POLE_BOTTOM = -0.6
+FLAG_POLE_TOP = 1.06
+FLAG_POLE_COLOR = "#7a6a58"
+#: scale of the face's local blendshapes (mouth, brows, cheeks, lips) and the jaw's opening angle in
+#: radians: large enough for the expressions to read apart at gallery size, without self-intersections
+FACE_BLENDSHAPE_SCALE = 1.7
+FACE_JAW_ANGLE = 0.34
 FACE_DEFAULT_RESOLUTION = 2000
 FACE_BLEND_RADIUS = 0.02
 

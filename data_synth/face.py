@@ -102,7 +102,6 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     inner = _gauss(V, (0.0, 0.045, 0.085), (0.018, 0.014, 0.03))
     out["brow_inner_up"] = np.array([0.0, 0.006, 0.0]) * inner[:, None]
     lips = _gauss(V, (0.0, -0.044, 0.095), (0.02, 0.014, 0.02))
-    out["pucker"] = np.stack([-0.3 * x, np.zeros_like(x), 0.009 * np.ones_like(x)], 1) * lips[:, None]
     # lips press together: the upper lip moves down, the lower up (a smooth step across the
     # mouth line, never a jump between neighbouring vertices)
     across = np.tanh((V[:, 1] + 0.044) / 0.006)
@@ -117,7 +116,11 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     below = _smoothstep((-0.044 - V[:, 1]) / 0.03 + 0.35)
     not_neck = _smoothstep((V[:, 2] - 0.0) / 0.05)
     w = below * not_neck * front
-    R = axis_rotation((1.0, 0.0, 0.0), 0.3)
+    out = {k: C.FACE_BLENDSHAPE_SCALE * d for k, d in out.items()}
+    # pucker: the lips push forward (scaled like the others) and draw together sideways (not
+    # scaled: more would crush the edges across the mouth)
+    out["pucker"] = np.stack([-0.3 * x, np.zeros_like(x), C.FACE_BLENDSHAPE_SCALE * 0.009 * np.ones_like(x)], 1) * lips[:, None]
+    R = axis_rotation((1.0, 0.0, 0.0), C.FACE_JAW_ANGLE)
     out["jaw_open"] = ((V - pivot) @ R.T + pivot - V) * w[:, None]
     return out
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from data_synth import constants as C
 from data_synth.collection import SynthCollection
-from data_synth.meshing import grid_sheet
+from data_synth.meshing import grid_sheet, grid_tube
 
 __all__ = ["make_flag", "flag_frames"]
 
@@ -68,6 +68,20 @@ def flag_frames(uv: np.ndarray, n_u: int, n_v: int, times: np.ndarray, rng: np.r
     return pos.reshape(len(times), n_u * n_v, 3), strength
 
 
+def flag_pole() -> tuple[np.ndarray, np.ndarray]:
+    """The pole the flag hangs on, as scenery (not part of the collection): an open cylinder along
+    ``y`` through the sheet's attached edge ``x = 0``, from below the sheet to just above it.
+
+    Returns ``V (n, 3) float64, F (m, 3) int64``.
+    """
+    r, bottom, top = C.FLAG_POLE_RADIUS, C.FLAG_POLE_BOTTOM, C.FLAG_POLE_TOP
+    V, F = grid_tube(12, 24, top - bottom, r)
+    V = V[:, [1, 0, 2]]                       # along y
+    V[:, 1] += bottom
+    V[:, 0] -= r                              # the sheet's edge touches the pole's surface
+    return V, F[:, [0, 2, 1]]                 # swapping two axes flipped the orientation
+
+
 def make_flag(seed: int = 0, resolution: int | None = None,
               n_frames: int = C.FLAG_N_FRAMES) -> SynthCollection:
     """A waving flag: ``n_frames`` frames, 1/25 s apart; labels ``frame`` and ``wind``."""
@@ -77,10 +91,12 @@ def make_flag(seed: int = 0, resolution: int | None = None,
     rng = np.random.default_rng(seed)
     times = np.arange(n_frames) / 25.0
     V, strength = flag_frames(uv, n_u, n_v, times, rng)
+    pole = flag_pole()
     wind = np.where(strength < 1 / 3, "calm", np.where(strength < 2 / 3, "breeze", "gust"))
     return SynthCollection(
         vertices=V, faces=F, names=[f"frame_{i:03d}" for i in range(n_frames)],
         labels={"frame": np.arange(n_frames, dtype=np.int64), "wind": wind},
         description="a flag on a pole waving in gusty wind (one boundary loop)",
-        extras={"rest": V0, "grid_shape": (n_u, n_v), "wind_strength": strength},
+        extras={"rest": V0, "grid_shape": (n_u, n_v), "wind_strength": strength,
+                "props": [(pole[0], pole[1], C.FLAG_POLE_COLOR)]},  # scenery for renderings
     )

@@ -206,3 +206,17 @@ def test_bar_ends_rotate_past_180_degrees(collections):
         # the first frame is the straight, untwisted bar
         first = idx[np.argmin(col.labels["frame"][idx])]
         assert _ring_rotations(col, first).magnitude().max() < 1e-9
+
+
+def test_flag_pole_is_scenery_along_the_attached_edge(collections):
+    col = collections["flag"]
+    (Vp, Fp, _), = col.extras["props"]
+    assert Fp.min() == 0 and Fp.max() == len(Vp) - 1
+    attached = col.vertices[:, np.isclose(col.extras["rest"][:, 0], 0.0)]        # the sheet's edge x = 0
+    axis = np.array([-C.FLAG_POLE_RADIUS, 0.0])
+    assert np.allclose(np.linalg.norm(attached[..., [0, 2]] - axis, axis=-1), C.FLAG_POLE_RADIUS)  # on its surface
+    assert Vp[:, 1].min() < attached[..., 1].min() and Vp[:, 1].max() > attached[..., 1].max()
+    # outward normals: every face normal points away from the pole's axis
+    n = np.cross(Vp[Fp[:, 1]] - Vp[Fp[:, 0]], Vp[Fp[:, 2]] - Vp[Fp[:, 0]])
+    out = Vp[Fp].mean(axis=1)[:, [0, 2]] - axis
+    assert np.all(np.einsum("ij,ij->i", n[:, [0, 2]], out) > 0)

@@ -82,6 +82,25 @@ def test_render_mesh_paints_back_to_front(sphere):
     assert np.all(np.diff(depth[drawn]) >= -1e-12)
 
 
+def test_render_mesh_props_are_depth_sorted_with_the_mesh_and_leave_the_frame(sphere):
+    V, F = sphere
+    ax = Figure().add_subplot()
+    plain = render_mesh(ax, V, F, view=(0, 0))
+    xlim = ax.get_xlim()
+    # a small red sphere in front of the big one (+z faces the viewer) and far to the right
+    prop = (0.2 * V + np.array([5.0, 0.0, 3.0]), F, (1.0, 0.0, 0.0))
+    ax2 = Figure().add_subplot()
+    both = render_mesh(ax2, V, F, view=(0, 0), ambient=1.0, props=[prop])
+    assert len(both.get_paths()) == 2 * len(plain.get_paths())
+    assert ax2.get_xlim() == pytest.approx(xlim)          # the frame still fits the mesh alone
+    red = np.all(np.isclose(both.get_facecolors()[:, :3], (1.0, 0.0, 0.0)), axis=1)
+    assert red.sum() == len(F) and np.all(red[-len(F):])  # the prop is nearer: painted last
+    with pytest.raises(ValueError, match=r"props\[0\] must be \(V, F, colour\)"):
+        render_mesh(ax2, V, F, props=[(V, F)])
+    with pytest.raises(ValueError, match="indices into its"):
+        render_mesh(ax2, V, F, props=[(V[:3], F, "red")])
+
+
 def test_render_mesh_validates(sphere):
     V, F = sphere
     ax = Figure().add_subplot()

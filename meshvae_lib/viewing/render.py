@@ -130,6 +130,7 @@ def render_mesh(
     cull_backfaces: bool = False,
     extent=None,
     center=None,
+    props=None,
 ):
     """Draw one shaded mesh into a 2D matplotlib axes.
 
@@ -154,6 +155,9 @@ def render_mesh(
         several axes to draw them at one scale.
     center : (2,) float, optional
         Screen-space centre of the frame (default: the centre of the mesh's projection).
+    props : list of (V (k, 3) float, F (m, 3) int, colour), optional
+        Static scenery drawn with the mesh and depth-sorted with it (e.g. a flag's pole); it does
+        not move the frame, which stays fitted to the mesh.
 
     Returns
     -------
@@ -169,9 +173,23 @@ def render_mesh(
     if F.min() < 0 or F.max() >= len(V):
         raise ValueError(f"F indexes vertices {F.min()}..{F.max()} but V has {len(V)} vertices")
     R = view_basis(view, up)
+    P_mesh = V @ R.T
+    base = _face_colors(colors, len(V), F)
+    if props:
+        parts_V, parts_F, parts_C, offset = [V], [F], [base], len(V)
+        for k, prop in enumerate(props):
+            if len(prop) != 3:
+                raise ValueError(f"props[{k}] must be (V, F, colour), got {len(prop)} items")
+            Vp, Fp = check_vertices(prop[0], f"props[{k}] V"), np.asarray(prop[1], dtype=np.int64)
+            if Fp.ndim != 2 or Fp.shape[1] != 3 or len(Fp) == 0 or Fp.min() < 0 or Fp.max() >= len(Vp):
+                raise ValueError(f"props[{k}] F must be (n_faces, 3) indices into its {len(Vp)} vertices")
+            parts_V.append(Vp)
+            parts_F.append(Fp + offset)
+            parts_C.append(_face_colors(prop[2], len(Vp), Fp))
+            offset += len(Vp)
+        V, F, base = np.concatenate(parts_V), np.concatenate(parts_F), np.concatenate(parts_C)
     P = V @ R.T
     N = face_normals(V, F)
-    base = _face_colors(colors, len(V), F)
     rgb = np.clip(base * shade(N, R, ambient=ambient, diffuse=1.0 - ambient)[:, None], 0.0, 1.0)
     depth = P[F, 2].mean(axis=1)
     keep = np.ones(len(F), dtype=bool)
@@ -188,7 +206,7 @@ def render_mesh(
         antialiaseds=True,
     )
     ax.add_collection(coll)
-    lo, hi = P[:, :2].min(axis=0), P[:, :2].max(axis=0)
+    lo, hi = P_mesh[:, :2].min(axis=0), P_mesh[:, :2].max(axis=0)
     c = 0.5 * (lo + hi) if center is None else np.asarray(center, dtype=np.float64)
     e = 0.55 * float(np.max(hi - lo)) if extent is None else float(extent)
     e = max(e, 1e-12)
