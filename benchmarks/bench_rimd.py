@@ -41,10 +41,10 @@ sys.path.insert(0, str(ROOT / "tests"))  # the procedural meshes of the test fix
 
 from geometry_fixtures import bumpy, tube, twist_bend  # noqa: E402
 
-from meshvae_lib.alignment import bounding_box_diagonal, rigid_align  # noqa: E402
-from meshvae_lib.mesh_io import read_collection  # noqa: E402
-from meshvae_lib.reconstruction import RIMDReconstructor  # noqa: E402
-from meshvae_lib.rimd import RIMDEncoder  # noqa: E402
+from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align  # noqa: E402
+from meshvae_lib.geometry.mesh_io import read_collection  # noqa: E402
+from meshvae_lib.geometry.reconstruction import RIMDReconstructor  # noqa: E402
+from meshvae_lib.geometry.rimd import RIMDEncoder  # noqa: E402
 
 SIZES = {"2k": (48, 41), "7k": (90, 76), "12k": (120, 99)}
 NOISE = (0.0, 1e-3, 1e-2)

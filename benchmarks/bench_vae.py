@@ -17,8 +17,8 @@ import time
 import numpy as np
 import torch
 
-from meshvae_lib.training import TrainConfig, train_vae
-from meshvae_lib.vae import MeshVAE, start_step, vae_loss
+from meshvae_lib.model.training import TrainConfig, train_vae
+from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
 
 
 def rimd_k(n_vertices: int) -> int:

@@ -6,10 +6,10 @@ decode z -> mesh, numpy vertex normals, float32 buffers, and the pythreejs attri
 attached the final zmq send is a no-op, a few hundred microseconds for 2 x 36 KB at 3k vertices).
 
 Decoders:
-- "MeshVAE+RIMD": a real :class:`meshvae_lib.checkpoint.MeshVAEModel` (RIMD features, latent 128,
+- "MeshVAE+RIMD": a real :class:`meshvae_lib.model.checkpoint.MeshVAEModel` (RIMD features, latent 128,
   trained for 2 epochs on 12 meshes of the synthetic "scape" collection: latency does not depend on
   how well it is trained) whose ``decode_latent`` runs the network, the inverse feature
-  normalisation and :class:`~meshvae_lib.reconstruction.RIMDReconstructor`;
+  normalisation and :class:`~meshvae_lib.geometry.reconstruction.RIMDReconstructor`;
 - "stand-in (linear)": ``V0 + z @ B``, to show the viewer's own share.
 If the learning modules or data_synth cannot be imported, only the stand-in runs, and the table
 says so. Medians and 90th percentiles over 30 moves after 3 warm-up moves; target < 100 ms.
@@ -51,8 +51,8 @@ def _real_model(resolution: int):
         from types import SimpleNamespace
 
         from data_synth.registry import make_collection
-        from meshvae_lib.checkpoint import MeshVAEModel
-        from meshvae_lib.training import TrainConfig
+        from meshvae_lib.model.checkpoint import MeshVAEModel
+        from meshvae_lib.model.training import TrainConfig
     except ImportError as err:
         return None, f"real model unavailable ({err})"
     torch.set_num_threads(2)
@@ -76,7 +76,7 @@ def _time_moves(explorer, dim: int, moves: int, warmup: int = 3):
 
 def _parts(decode, latent_dim, viewer, moves):
     """Medians of the three stages separately (decode, normals, buffer hand-off)."""
-    from meshvae_lib.topology import vertex_normals
+    from meshvae_lib.geometry.topology import vertex_normals
 
     rng = np.random.default_rng(0)
     dec, nrm, buf = [], [], []

@@ -8,7 +8,7 @@ were recorded (``results.json`` holds the definitions' fingerprint, the commit, 
 the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
-  ``meshvae_lib.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
+  ``meshvae_lib.paper.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
   their nearest training meshes), ``interpolation_meshes.png`` (Fig. 4), ``exploration_level1.png``
   and ``exploration_level2.png`` (Fig. 8);
 - ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from meshvae_lib import experiments as exps  # noqa: E402
+from meshvae_lib.paper import experiments as exps  # noqa: E402
 
 SHORT = {
     "table1": exps.latent_size_table,

@@ -36,10 +36,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from meshvae_lib.checkpoint import MeshVAEModel
-from meshvae_lib.evaluation import evaluate_model, pca_baseline
-from meshvae_lib.mesh_io import MeshCollection
-from meshvae_lib.training import TrainConfig, holdout_mask
+from meshvae_lib.model.checkpoint import MeshVAEModel
+from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
+from meshvae_lib.geometry.mesh_io import MeshCollection
+from meshvae_lib.model.training import TrainConfig, holdout_mask
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 REAL = ("samba", "pdance", "pcow")

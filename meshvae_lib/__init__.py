@@ -2,9 +2,9 @@
 
 The library is a set of small modules, one concept each; import what you need::
 
-    from meshvae_lib.mesh_io import read_collection
-    from meshvae_lib.rimd import rimd_features
-    from meshvae_lib.reconstruction import RIMDReconstructor
+    from meshvae_lib.geometry.mesh_io import read_collection
+    from meshvae_lib.geometry.rimd import rimd_features
+    from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 
 Importing the package does no work: heavy dependencies (torch, pythreejs) are imported only by the
 modules that need them.

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import torch
 
-from meshvae_lib.checkpoint import MeshVAEModel, load_model, save_model
-from meshvae_lib.mesh_io import MeshCollection
-from meshvae_lib.training import TrainConfig
+from meshvae_lib.model.checkpoint import MeshVAEModel, load_model, save_model
+from meshvae_lib.geometry.mesh_io import MeshCollection
+from meshvae_lib.model.training import TrainConfig
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -163,7 +163,7 @@ def test_conditioning_changes_what_is_generated(collection, tmp_path):
 
 
 def test_pca_started_model_round_trips_and_is_at_least_as_good_as_its_pca_start(collection, tmp_path):
-    from meshvae_lib.evaluation import evaluate_model, pca_baseline
+    from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
 
     model = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40, init="pca")).fit(collection)
     assert model.network_.input_rank > 0 and model.normalizer_.a == 0.3 and model.normalizer_.scale == "shared"
@@ -180,7 +180,7 @@ def test_pca_started_model_round_trips_and_is_at_least_as_good_as_its_pca_start(
 
 
 def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
-    from meshvae_lib.evaluation import evaluate_model, per_vertex_error
+    from meshvae_lib.model.evaluation import evaluate_model, per_vertex_error
 
     model = MeshVAEModel("rimd", TrainConfig(progress=False, epochs=20, latent_dim=8), holdout_every=4).fit(collection)
     held = np.flatnonzero(model.holdout_mask_)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from geometry_fixtures import bumpy, tube, twist_bend
 
-from meshvae_lib.alignment import bounding_box_diagonal, rigid_align
+from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
 from meshvae_lib.cli import main
-from meshvae_lib.mesh_io import read_collection, write_collection, write_mesh
-from meshvae_lib.rimd import RIMDLayout, load_features
+from meshvae_lib.geometry.mesh_io import read_collection, write_collection, write_mesh
+from meshvae_lib.geometry.rimd import RIMDLayout, load_features
 
 
 @pytest.fixture

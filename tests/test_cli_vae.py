@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from meshvae_lib.cli import main
-from meshvae_lib.mesh_io import MeshCollection, read_collection, write_collection, write_mesh
+from meshvae_lib.geometry.mesh_io import MeshCollection, read_collection, write_collection, write_mesh
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -44,7 +44,7 @@ def data(tmp_path_factory):
 
 def test_train_writes_a_loadable_model(data, capsys):
     root, path, model, coll = data
-    from meshvae_lib.checkpoint import load_model
+    from meshvae_lib.model.checkpoint import load_model
 
     m = load_model(model, read_collection(path))
     assert m.network_.latent_dim == 4 and m.config.epochs == 8 and m.extractor_.kind == "rimd"
@@ -135,7 +135,7 @@ def test_help_texts_describe_the_commands(capsys):
 
 def test_evaluate_reports_the_pca_baseline(data, capsys):
     root, path, model, coll = data
-    from meshvae_lib.evaluation import pca_baseline
+    from meshvae_lib.model.evaluation import pca_baseline
 
     capsys.readouterr()
     assert main(["evaluate", str(model), str(path), "--held-out", "--pca", "--json"]) == 0

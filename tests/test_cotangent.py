@@ -5,8 +5,8 @@ import pytest
 from geometry_fixtures import bumpy, icosphere, tube
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.cotangent import corner_cotangents, cotangent_weights
-from meshvae_lib.topology import edge_index, edges
+from meshvae_lib.geometry.cotangent import corner_cotangents, cotangent_weights
+from meshvae_lib.geometry.topology import edge_index, edges
 
 
 def _naive_weights(V, F):

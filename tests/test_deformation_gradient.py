@@ -5,9 +5,9 @@ import pytest
 from geometry_fixtures import bumpy, grid, icosphere, random_rotation, tube, twist_bend
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.cotangent import cotangent_weights
-from meshvae_lib.deformation_gradient import DeformationGradientOperator, deformation_gradients
-from meshvae_lib.topology import edge_index, edges, one_rings, vertex_normal_sums
+from meshvae_lib.geometry.cotangent import cotangent_weights
+from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator, deformation_gradients
+from meshvae_lib.geometry.topology import edge_index, edges, one_rings, vertex_normal_sums
 
 AFFINE = np.array([[1.2, 0.3, 0.1], [-0.2, 0.9, 0.4], [0.1, 0.2, 1.1]])
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from meshvae_lib import embedding as emb
+from meshvae_lib.applications import embedding as emb
 
 # ---------------------------------------------------------------------------------------------
 # NPE

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from meshvae_lib.evaluation import evaluate_model, per_vertex_error
-from meshvae_lib.mesh_io import MeshCollection
+from meshvae_lib.model.evaluation import evaluate_model, per_vertex_error
+from meshvae_lib.geometry.mesh_io import MeshCollection
 
 
 def test_error_of_rigidly_moved_copy_is_zero_after_alignment(rng):
@@ -78,8 +78,8 @@ def test_evaluate_model_reports_mean_and_per_mesh_numbers(rng):
 
 # --- linear PCA baseline ------------------------------------------------------------------------
 
-from meshvae_lib.alignment import rigid_align  # noqa: E402
-from meshvae_lib.evaluation import CoordinatePCA, pca_baseline  # noqa: E402
+from meshvae_lib.geometry.alignment import rigid_align  # noqa: E402
+from meshvae_lib.model.evaluation import CoordinatePCA, pca_baseline  # noqa: E402
 
 
 def _low_rank_meshes(rng, n=12, nv=30, rank=3, scale=0.05):
@@ -139,9 +139,9 @@ def test_default_rimd_model_generalises_better_than_coordinate_pca_and_the_paper
     and against the paper's training (random start, all epochs) on the same held-out meshes.
     Measured (seed 0, 302 vertices, latent 16): default 1.2e-2 (training meshes 8.5e-3), PCA 2.2e-2, paper's training 5.6e-2."""
     from data_synth.registry import make_collection
-    from meshvae_lib.checkpoint import MeshVAEModel
-    from meshvae_lib.evaluation import pca_baseline
-    from meshvae_lib.training import TrainConfig
+    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.evaluation import pca_baseline
+    from meshvae_lib.model.training import TrainConfig
 
     coll = make_collection("scape", seed=0, resolution=300)
     latent = 16

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from meshvae_lib import experiments as exps
+from meshvae_lib.paper import experiments as exps
 
 
 @dataclass
@@ -90,7 +90,7 @@ def test_latent_size_table(coll, cache):
     errs = t.data["errors"]["ellipsoids"]
     assert len(errs) == 2 and _finite_positive(errs)
     # the numbers are the held-out errors of the cached models
-    from meshvae_lib.evaluation import evaluate_model
+    from meshvae_lib.model.evaluation import evaluate_model
 
     d = exps.load_collection(coll, SETTINGS, cache=cache)
     model = exps._train(d, SETTINGS, cache, latent_dim=8)
@@ -169,7 +169,7 @@ def test_embedding_table(coll, cache):
     aucs = np.array(t.column("AUC (mean)"), dtype=float)
     assert np.all((aucs > 0) & (aucs <= 1))
     # the table's number is the retrieval AUC of the stored embedding
-    from meshvae_lib.embedding import retrieval_auc
+    from meshvae_lib.applications.embedding import retrieval_auc
 
     Y = t.data["embeddings"]["PCA"]
     assert retrieval_auc(Y, t.data["labels"]) == pytest.approx(aucs[2], abs=1e-12)
@@ -215,7 +215,7 @@ RESULTS = __import__("pathlib").Path(__file__).resolve().parents[1] / "docs" / "
 
 def test_the_committed_full_results_are_current():
     """docs/results holds a full `make experiments` run (notebook 09 shows it). When the experiments'
-    definitions (meshvae_lib/experiments.py or the default settings) change, it is stale: rerun
+    definitions (meshvae_lib/paper/experiments.py or the default settings) change, it is stale: rerun
     `make experiments` and commit docs/results."""
     res = exps.read_results(RESULTS)
     assert res.provenance["preset"] == "full" and res.settings == exps.ExperimentSettings()

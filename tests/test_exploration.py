@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from meshvae_lib import exploration as ex
+from meshvae_lib.applications import exploration as ex
 
 
 def _stick_body():

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from meshvae_lib.alignment import rigid_align
-from meshvae_lib.features import ConditionEncoder, FeatureExtractor
-from meshvae_lib.rimd import RIMDLayout
-from meshvae_lib.topology import edges
-from meshvae_lib.training import default_hidden
+from meshvae_lib.geometry.alignment import rigid_align
+from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
+from meshvae_lib.geometry.rimd import RIMDLayout
+from meshvae_lib.geometry.topology import edges
+from meshvae_lib.model.training import default_hidden
 from meshvae_lib.tolerances import HIDDEN_COORDS
 
 

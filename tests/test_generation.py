@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from meshvae_lib import generation as gen
+from meshvae_lib.applications import generation as gen
 
 
 @dataclass
@@ -37,8 +37,8 @@ def _tiny_collection(n=12, seed=0):
 
 
 def _tiny_model(coll, labels=(), seed=0):
-    from meshvae_lib.checkpoint import MeshVAEModel
-    from meshvae_lib.training import TrainConfig
+    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.training import TrainConfig
 
     cfg = TrainConfig(epochs=5, batch_size=4, latent_dim=3, seed=seed, device="cpu", progress=False)
     return MeshVAEModel(features="coords", config=cfg, labels=labels).fit(coll)

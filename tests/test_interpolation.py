@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from meshvae_lib import interpolation as itp
+from meshvae_lib.applications import interpolation as itp
 
 
 def _grid_mesh(n=6, size=1.0):
@@ -71,7 +71,7 @@ def test_edge_length_distortion_against_brute_force(rng):
     data = V[None] + 0.05 * rng.normal(size=(7, 16, 3))
     query = V[None] + 0.05 * rng.normal(size=(3, 16, 3))
     d, nn = itp.edge_length_distortion(query, F, data)
-    from meshvae_lib.topology import edges
+    from meshvae_lib.geometry.topology import edges
 
     E = edges(F)
     for q in range(3):
@@ -211,7 +211,7 @@ def test_batch_and_implausibility_table(rng):
 
 
 def test_latent_path_decodes_the_straight_blend():
-    from meshvae_lib.interpolation import LatentPath
+    from meshvae_lib.applications.interpolation import LatentPath
 
     seen = []
     path = LatentPath(lambda z: (seen.append(z), np.tile(z[:1], (4, 3)))[1], np.array([0.0, 2.0]), np.array([1.0, 0.0]))

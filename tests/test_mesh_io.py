@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from geometry_fixtures import icosphere, tube
 
-from meshvae_lib.mesh_io import (
+from meshvae_lib.geometry.mesh_io import (
     MeshCollection, natural_key, read_collection, read_mesh, remove_unreferenced_vertices,
     validate_mesh, write_collection, write_mesh)
 

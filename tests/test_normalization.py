@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from meshvae_lib.normalization import FeatureNormalizer
+from meshvae_lib.model.normalization import FeatureNormalizer
 from meshvae_lib.tolerances import NORMALIZE_A, NORMALIZE_EPS
 
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from geometry_fixtures import bumpy, icosphere, random_rotation, tube, twist_bend
 
-from meshvae_lib.alignment import bounding_box_diagonal, rigid_align
-from meshvae_lib.reconstruction import RIMDReconstructor
-from meshvae_lib.rimd import RIMDEncoder
+from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
+from meshvae_lib.geometry.reconstruction import RIMDReconstructor
+from meshvae_lib.geometry.rimd import RIMDEncoder
 
 AFFINE = np.array([[1.2, 0.3, 0.1], [-0.2, 0.9, 0.4], [0.1, 0.2, 1.1]])
 
@@ -123,8 +123,8 @@ def test_recover_rotations_exact_up_to_global_rotation(bar):
     V = twist_bend(V0, 200.0, 80.0)
     enc = RIMDEncoder(V0, F, layout="compact")
     log_dR, _ = enc.layout.unpack(enc.transform(V))
-    from meshvae_lib.deformation_gradient import deformation_gradients
-    from meshvae_lib.rotations import polar_decomposition
+    from meshvae_lib.geometry.deformation_gradient import deformation_gradients
+    from meshvae_lib.geometry.rotations import polar_decomposition
 
     R_true, _ = polar_decomposition(deformation_gradients(V0, V, F))
     for how in ("global", "bfs"):
@@ -150,8 +150,8 @@ def test_bad_input(bar):
 
 def test_reflected_one_rings_keep_rotations_and_reconstruct():
     # mirror a curved mesh: T_i has det < 0 at (almost) every vertex
-    from meshvae_lib.deformation_gradient import deformation_gradients
-    from meshvae_lib.rotations import polar_decomposition
+    from meshvae_lib.geometry.deformation_gradient import deformation_gradients
+    from meshvae_lib.geometry.rotations import polar_decomposition
 
     V0, F = icosphere(2)
     V0 = bumpy(V0, seed=8)
@@ -167,7 +167,7 @@ def test_reflected_one_rings_keep_rotations_and_reconstruct():
 
 
 def test_irregular_mesh_with_obtuse_and_sliver_triangles():
-    from meshvae_lib.cotangent import cotangent_weights
+    from meshvae_lib.geometry.cotangent import cotangent_weights
     from meshvae_lib import tolerances as tol
 
     V0, F = tube(10, 12)

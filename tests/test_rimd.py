@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from geometry_fixtures import bumpy, random_rotation, tube, twist_bend
 
-from meshvae_lib.deformation_gradient import deformation_gradients
-from meshvae_lib.rimd import S_ENTRIES, RIMDEncoder, RIMDLayout, rimd_features
-from meshvae_lib.rotations import polar_decomposition, so3_log
-from meshvae_lib.topology import edges
+from meshvae_lib.geometry.deformation_gradient import deformation_gradients
+from meshvae_lib.geometry.rimd import S_ENTRIES, RIMDEncoder, RIMDLayout, rimd_features
+from meshvae_lib.geometry.rotations import polar_decomposition, so3_log
+from meshvae_lib.geometry.topology import edges
 
 
 @pytest.fixture(scope="module")

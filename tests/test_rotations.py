@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from geometry_fixtures import random_rotation
 
-from meshvae_lib.rotations import (
+from meshvae_lib.geometry.rotations import (
     hat, polar_decomposition, project_to_so3, rotation_angle, so3_exp, so3_log, vee)
 
 
@@ -125,7 +125,7 @@ def test_bad_shapes():
 
 
 def test_quaternion_relative_log_matches_matrix_log():
-    from meshvae_lib.rotations import _quat_from_soa, _relative_log_quat, to_soa
+    from meshvae_lib.geometry.rotations import _quat_from_soa, _relative_log_quat, to_soa
 
     rng = np.random.default_rng(4)
     w = rng.standard_normal((500, 3))

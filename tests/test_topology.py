@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from geometry_fixtures import grid, icosphere, random_rotation, tube
 
-from meshvae_lib import topology as T
+from meshvae_lib.geometry import topology as T
 
 # two triangles sharing edge (0, 2): a unit square in the z = 0 plane
 SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])

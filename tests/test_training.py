@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import torch
 
-from meshvae_lib.normalization import FeatureNormalizer
-from meshvae_lib.training import TrainConfig, holdout_mask, pad_sigma_object, resolve_device, train_vae
+from meshvae_lib.model.normalization import FeatureNormalizer
+from meshvae_lib.model.training import TrainConfig, holdout_mask, pad_sigma_object, resolve_device, train_vae
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -143,8 +143,8 @@ def test_divergence_stops_with_a_clear_error():
 
 # --- PCA initialisation and early stopping (issue 12) ---------------------------------------------
 
-from meshvae_lib.training import pca_network  # noqa: E402
-from meshvae_lib.vae import MeshVAE  # noqa: E402
+from meshvae_lib.model.training import pca_network  # noqa: E402
+from meshvae_lib.model.vae import MeshVAE  # noqa: E402
 
 
 def _in_range(n=30, k=80, rank=5, seed=1, a=0.3):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvae_lib.topology import vertex_normals
+from meshvae_lib.geometry.topology import vertex_normals
 from meshvae_lib.viewing.buffers import (
     color_buffer,
     fit_camera,

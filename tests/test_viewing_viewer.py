@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvae_lib.topology import vertex_normals
+from meshvae_lib.geometry.topology import vertex_normals
 from meshvae_lib.viewing.viewer import MeshViewer, as_mesh_stack
 
 pytest.importorskip("pythreejs")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvae_lib.topology import vertex_normals
+from meshvae_lib.geometry.topology import vertex_normals
 from meshvae_lib.viewing.widgets import FramePlayer, InterpolationSlider, LatentExplorer
 
 pytest.importorskip("pythreejs")

@@ -36,7 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Mesh variational autoencoders (Tan et al., CVPR 2018): RIMD features, "
         "reconstruction, training and applications on your own deforming meshes.",
     )
-    from .. import __version__
+    from meshvae_lib import __version__
 
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
@@ -62,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from ..model.threads import ENV_VAR, configure_threads
+    from meshvae_lib.model.threads import ENV_VAR, configure_threads
 
     try:
         if os.environ.get(ENV_VAR, "").strip():  # only then, so that commands without torch stay fast

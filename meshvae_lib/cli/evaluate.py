@@ -50,9 +50,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..checkpoint import load_model
-    from ..evaluation import evaluate_model
-    from ..mesh_io import read_collection
+    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.evaluation import evaluate_model
+    from meshvae_lib.geometry.mesh_io import read_collection
 
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
@@ -62,7 +62,7 @@ def run(args) -> int:
     if args.pca is not None:
         import numpy as np
 
-        from ..evaluation import pca_baseline
+        from meshvae_lib.model.evaluation import pca_baseline
 
         if args.pca:
             train = read_collection(args.pca, allow_degenerate=args.allow_degenerate)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.defaults import LAYOUTS
+from meshvae_lib.model.defaults import LAYOUTS
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)
@@ -51,7 +51,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _pick_reference(spec: str, collection, allow_degenerate: bool) -> tuple[np.ndarray, str]:
-    from ..mesh_io import read_mesh
+    from meshvae_lib.geometry.mesh_io import read_mesh
 
     n = len(collection)
     try:
@@ -79,8 +79,8 @@ def _pick_reference(spec: str, collection, allow_degenerate: bool) -> tuple[np.n
 
 
 def run(args) -> int:
-    from ..mesh_io import read_collection
-    from ..rimd import RIMDEncoder, save_features
+    from meshvae_lib.geometry.mesh_io import read_collection
+    from meshvae_lib.geometry.rimd import RIMDEncoder, save_features
 
     out = Path(args.output)
     if out.suffix.lower() != ".npz":

@@ -39,8 +39,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..checkpoint import load_model
-    from ..mesh_io import write_collection
+    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.geometry.mesh_io import write_collection
 
     if args.n < 1:
         raise ValueError(f"-n must be >= 1, got {args.n}")

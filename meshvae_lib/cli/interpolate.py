@@ -38,7 +38,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def _resolve(spec: str, collection, what: str):
     """-> (vertices (n, 3), label row dict or None, name)."""
-    from ..mesh_io import read_mesh
+    from meshvae_lib.geometry.mesh_io import read_mesh
 
     if collection is not None:
         try:
@@ -62,8 +62,8 @@ def _resolve(spec: str, collection, what: str):
 
 
 def run(args) -> int:
-    from ..checkpoint import load_model
-    from ..mesh_io import read_collection, write_collection
+    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.geometry.mesh_io import read_collection, write_collection
 
     if args.steps < 2:
         raise ValueError(f"--steps must be >= 2 (both ends are included), got {args.steps}")

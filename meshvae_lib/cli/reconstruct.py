@@ -7,7 +7,7 @@ import logging
 import sys
 from pathlib import Path
 
-from ..model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+from meshvae_lib.model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
 
 logger = logging.getLogger(__name__)
 
@@ -48,9 +48,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..mesh_io import write_collection
-    from ..reconstruction import RIMDReconstructor
-    from ..rimd import load_features
+    from meshvae_lib.geometry.mesh_io import write_collection
+    from meshvae_lib.geometry.reconstruction import RIMDReconstructor
+    from meshvae_lib.geometry.rimd import load_features
 
     out = Path(args.output)
     if out.suffix.lower() == ".npz" and not out.parent.is_dir():

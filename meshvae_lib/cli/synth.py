@@ -66,7 +66,7 @@ def run(args) -> int:
     start = time.perf_counter()
     col = make_collection(args.name, seed=args.seed, resolution=args.resolution)
     logger.info("built %s in %.2f s", args.name, time.perf_counter() - start)
-    from meshvae_lib.mesh_io import write_collection
+    from meshvae_lib.geometry.mesh_io import write_collection
 
     write_collection(out, col.vertices, col.faces, names=col.names, labels=col.labels)
     print(f"wrote {args.name}: {len(col.vertices)} meshes x {col.vertices.shape[1]} vertices, "

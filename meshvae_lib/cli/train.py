@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import logging
 
-from ..model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
-from ..tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
+from meshvae_lib.model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
+from meshvae_lib.tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)
@@ -83,10 +83,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..checkpoint import MeshVAEModel
-    from ..evaluation import evaluate_model
-    from ..mesh_io import read_collection
-    from ..training import TrainConfig, default_hidden
+    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.evaluation import evaluate_model
+    from meshvae_lib.geometry.mesh_io import read_collection
+    from meshvae_lib.model.training import TrainConfig, default_hidden
 
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     if args.latent < 1:

@@ -112,7 +112,7 @@ def _cmd_student(args) -> int:
 
 
 def _cmd_models(args) -> int:
-    from ..model.threads import configure_threads
+    from meshvae_lib.model.threads import configure_threads
     from . import models as cm
 
     configure_threads(2)  # as the notebooks do (MESHVAE_NUM_THREADS overrides it)

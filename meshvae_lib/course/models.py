@@ -2,7 +2,7 @@
 
 Each entry of :data:`COURSE_MODELS` names a ``data_synth`` collection (name, seed, resolution), what
 the lesson needs from the model (features, labels, a sigma_object prior) and a training budget.
-:func:`course_model` returns the fitted :class:`~meshvae_lib.checkpoint.MeshVAEModel`: from the
+:func:`course_model` returns the fitted :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`: from the
 cache when an entry with the same key is there, else trained (with a progress bar), written to the
 cache and returned.
 
@@ -13,7 +13,7 @@ configuration, the numpy and torch versions and the source code of the library l
 the data and train the model. A change to any of them gives another key, so a stale entry is never
 loaded; it is removed when the new one is written. A damaged entry (a failed checksum, a truncated
 file) is logged, removed and rebuilt. Checkpoints are written atomically
-(:func:`~meshvae_lib.checkpoint.save_model`), so an interrupted build leaves no half-written entry.
+(:func:`~meshvae_lib.model.checkpoint.save_model`), so an interrupted build leaves no half-written entry.
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
-from meshvae_lib.embedding import embedding_sigma_object
-from meshvae_lib.exploration import exploration_sigma_object
+from meshvae_lib.applications.embedding import embedding_sigma_object
+from meshvae_lib.applications.exploration import exploration_sigma_object
 from meshvae_lib.tolerances import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN,
                                     EMBEDDING_SEEDS)
 
@@ -36,11 +36,11 @@ logger = logging.getLogger(__name__)
 #: environment variable that overrides the cache folder.
 CACHE_ENV = "MESHVAE_CACHE"
 
-#: the parts of meshvae_lib whose source does not determine a trained model: the applications (they
-#: use a model, not train it), the viewers, the command line and this course layer. Everything else,
+#: the parts of meshvae_lib whose source does not determine a trained model: the applications and
+#: the evaluation (they use a model, not train it), the paper's experiments (their own models), the
+#: viewers, the command line and this course layer. Everything else,
 #: and all of data_synth, is in the key.
-_CODE_EXCLUDED = ("viewing", "cli", "course", "generation.py", "interpolation.py", "embedding.py",
-                  "exploration.py", "experiments.py", "evaluation.py")
+_CODE_EXCLUDED = ("applications", "paper", "viewing", "cli", "course", "model/evaluation.py")
 
 
 @dataclass(frozen=True)
@@ -49,8 +49,8 @@ class CourseModelSpec:
 
     name : registry key; lesson : the notebook that uses it; collection : a ``data_synth`` name;
     resolution : template vertices (approximate); data_seed : the collection's seed;
-    features, labels, layout, holdout_every : :class:`~meshvae_lib.checkpoint.MeshVAEModel`'s
-    arguments; config : :class:`~meshvae_lib.training.TrainConfig` keywords (the budget: ``epochs``,
+    features, labels, layout, holdout_every : :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`'s
+    arguments; config : :class:`~meshvae_lib.model.training.TrainConfig` keywords (the budget: ``epochs``,
     ``latent_dim``, ...; ``progress`` is set by :func:`course_model`); minutes : the measured build
     time on 2 CPU cores, for the message shown before a build; description : one line.
     """
@@ -69,8 +69,8 @@ class CourseModelSpec:
     config: dict = field(default_factory=dict)
 
     def train_config(self, progress: bool = False):
-        """The :class:`~meshvae_lib.training.TrainConfig` this model is trained with."""
-        from meshvae_lib.training import TrainConfig
+        """The :class:`~meshvae_lib.model.training.TrainConfig` this model is trained with."""
+        from meshvae_lib.model.training import TrainConfig
 
         return TrainConfig(**{"device": "cpu", **self.config, "progress": progress})
 
@@ -174,7 +174,7 @@ def code_fingerprint() -> str:
         root = Path(package.__file__).parent
         for path in sorted(root.rglob("*.py")):
             rel = path.relative_to(root)
-            if rel.parts[0] in _CODE_EXCLUDED:
+            if rel.parts[0] in _CODE_EXCLUDED or rel.as_posix() in _CODE_EXCLUDED:
                 continue
             h.update(f"{package.__name__}/{rel.as_posix()}\0".encode())
             h.update(path.read_bytes())
@@ -216,7 +216,7 @@ def is_cached(name: str) -> bool:
 
 def build_model(name: str, progress: bool = True):
     """Train course model ``name`` from scratch (no cache). Returns the fitted MeshVAEModel."""
-    from meshvae_lib.checkpoint import MeshVAEModel
+    from meshvae_lib.model.checkpoint import MeshVAEModel
 
     spec = get_spec(name)
     model = MeshVAEModel(spec.features, spec.train_config(progress), labels=spec.labels,
@@ -225,14 +225,14 @@ def build_model(name: str, progress: bool = True):
 
 
 def course_model(name: str, progress: bool = True, rebuild: bool = False):
-    """The fitted course model ``name`` (a :class:`~meshvae_lib.checkpoint.MeshVAEModel`).
+    """The fitted course model ``name`` (a :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`).
 
     Loaded from the cache when an entry with the current key is there and reads back intact; else
     trained (a progress bar when ``progress``; a log message says how long the build takes),
     written to the cache atomically, and returned. ``rebuild``: train even when cached. Older
     entries of the same model (other keys) are removed when a new one is written.
     """
-    from meshvae_lib.checkpoint import load_model
+    from meshvae_lib.model.checkpoint import load_model
 
     spec = get_spec(name)
     key = model_key(spec)

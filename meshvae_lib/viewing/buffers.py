@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..topology import vertex_normals
+from meshvae_lib.geometry.topology import vertex_normals
 
 __all__ = [
     "check_vertices",
@@ -62,7 +62,7 @@ def position_buffer(V) -> np.ndarray:
 
 
 def normal_buffer(V, F) -> np.ndarray:
-    """Area-weighted unit vertex normals (:func:`meshvae_lib.topology.vertex_normals`) as float32.
+    """Area-weighted unit vertex normals (:func:`meshvae_lib.geometry.topology.vertex_normals`) as float32.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """Shaded matplotlib renderings of triangle meshes: static figures, the README, and the fallback.
 
 A small software renderer: an orthographic view from ``(elev, azim)``, Lambert shading of the
-face normals (:func:`meshvae_lib.topology.face_normals`, two-sided, light from the upper left of
+face normals (:func:`meshvae_lib.geometry.topology.face_normals`, two-sided, light from the upper left of
 the viewer), and the painter's algorithm (faces drawn far to near as one ``PolyCollection``). It
 uses a plain 2D axes, so it is fast (a 5k-face mesh renders in well under a second) and looks the
 same in every backend. Only ``matplotlib.figure`` and ``matplotlib.collections`` are imported;
@@ -16,7 +16,7 @@ import math
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..topology import face_normals
+from meshvae_lib.geometry.topology import face_normals
 from .buffers import check_vertices, color_buffer
 from .colors import DEFAULT_MESH_COLOR, ColorMapping
 

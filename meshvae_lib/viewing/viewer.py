@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from ..topology import vertex_normals
+from meshvae_lib.geometry.topology import vertex_normals
 from .buffers import check_vertices, color_buffer, fit_camera, index_buffer, position_buffer, row_offsets
 from .colors import DEFAULT_MESH_COLOR, ColorMapping, colorbar_html, label_colors, legend_html, scalar_colors
 from .fallback import ImageView, resolve_mode

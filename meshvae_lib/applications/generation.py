@@ -86,7 +86,7 @@ def nearest_neighbors(queries, dataset, chunk: int = 256, exclude_self: bool = F
 
 def rimd_feature_rows(reference, vertices, faces) -> np.ndarray:
     """RIMD features (Eq. 2) of meshes relative to ``reference``: (N, n, 3) -> (N, K) float64."""
-    from meshvae_lib.rimd import rimd_features
+    from meshvae_lib.geometry.rimd import rimd_features
 
     V = np.asarray(vertices, dtype=np.float64)
     X = rimd_features(np.asarray(reference, dtype=np.float64), V, np.asarray(faces, dtype=np.int64))

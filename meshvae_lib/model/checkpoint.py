@@ -1,6 +1,6 @@
 """A trained mesh VAE with everything needed to use it, and its one-file checkpoint.
 
-:class:`MeshVAEModel` bundles the network (:class:`~meshvae_lib.vae.MeshVAE`), the fitted
+:class:`MeshVAEModel` bundles the network (:class:`~meshvae_lib.model.vae.MeshVAE`), the fitted
 normaliser (Eq. 3), the feature extractor (reference mesh, faces, feature kind and RIMD layout) and
 the condition encoder (label names and encodings), so that applications and notebooks are
 one-liners::
@@ -27,11 +27,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .features import ConditionEncoder, FeatureExtractor
-from .tolerances import FIT_LATENT_STEP
-from .normalization import FeatureNormalizer
-from .training import TrainConfig, holdout_mask, pad_sigma_object, train_vae
-from .vae import MeshVAE
+from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
+from meshvae_lib.tolerances import FIT_LATENT_STEP
+from meshvae_lib.model.normalization import FeatureNormalizer
+from meshvae_lib.model.training import TrainConfig, holdout_mask, pad_sigma_object, train_vae
+from meshvae_lib.model.vae import MeshVAE
 
 __all__ = ["MeshVAEModel", "save_model", "load_model", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
 
@@ -80,7 +80,7 @@ class MeshVAEModel:
     Parameters
     ----------
     features : "rimd" | "aligned" | "coords" (the paper's Table 2; "rimd" is the mesh VAE proper).
-    config : :class:`~meshvae_lib.training.TrainConfig` (defaults when None).
+    config : :class:`~meshvae_lib.model.training.TrainConfig` (defaults when None).
     labels : label columns to condition on (conditional mesh VAE, Eq. 5); empty: unconditional.
     holdout_every : hold out every k-th mesh (k >= 2) from training to measure generalisation;
         0 trains on everything.
@@ -99,7 +99,7 @@ class MeshVAEModel:
         from: the config's sigma_object with the exact prior form, ones for the standard prior and
         for the sibling form (whose latent cost keeps the means' unit spread).
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
-    history_ : list of per-epoch dicts (see :class:`~meshvae_lib.training.TrainResult`).
+    history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`).
     train_seconds_ : float.
     train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
         ``config.epochs``, or 0: the PCA initialisation itself). Not stored in checkpoints.
@@ -124,7 +124,7 @@ class MeshVAEModel:
         network : callable, optional
             ``network(n_features, latent_dim, hidden, n_conditions) -> MeshVAE`` (a subclass, e.g.
             with another output layer or prior); built with the config's seed. Default: ``MeshVAE``
-            as :func:`~meshvae_lib.training.train_vae` builds it.
+            as :func:`~meshvae_lib.model.training.train_vae` builds it.
 
         Returns ``self``.
         """
@@ -301,7 +301,7 @@ class MeshVAEModel:
         used = np.flatnonzero(W[:, : self.network_.latent_dim].abs().sum(0).numpy() > 0) if not self.network_.hidden \
             else np.arange(self.network_.latent_dim)
         eye = np.eye(self.network_.latent_dim)[used] * step
-        from .alignment import rigid_align
+        from meshvae_lib.geometry.alignment import rigid_align
 
         for j in range(len(V)):
             c = None if C is None else C[j]

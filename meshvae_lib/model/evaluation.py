@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .alignment import bounding_box_diagonal, rigid_align
-from .tolerances import PCA_RANK_RTOL
+from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
+from meshvae_lib.tolerances import PCA_RANK_RTOL
 
 __all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline"]
 
@@ -36,7 +36,7 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
 def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0) -> dict:
     """Reconstruct meshes of ``collection`` (encode to the latent mean, decode) and measure them.
 
-    model : :class:`~meshvae_lib.checkpoint.MeshVAEModel`.
+    model : :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
     indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
         collection must then be the one it was trained on).

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import tolerances as tol
+from meshvae_lib import tolerances as tol
 
 __all__ = [
     "hat",

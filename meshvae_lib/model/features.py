@@ -4,7 +4,7 @@
 features and back. Three kinds, the columns of the paper's Table 2:
 
 - ``"rimd"``: the RIMD feature of every mesh relative to a reference mesh (Eq. 2), K = 6V + 6E;
-  decoding rebuilds the mesh with :class:`~meshvae_lib.reconstruction.RIMDReconstructor`, aligned to
+  decoding rebuilds the mesh with :class:`~meshvae_lib.geometry.reconstruction.RIMDReconstructor`, aligned to
   the reference (the feature carries no global pose).
 - ``"aligned"``: vertex coordinates after rigidly aligning each mesh to the reference (the paper's
   "aligned coordinates", global rotations found by minimising vertex differences), K = 3V.
@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .alignment import rigid_align
+from meshvae_lib.geometry.alignment import rigid_align
 
 __all__ = ["FEATURE_KINDS", "FeatureExtractor", "ConditionEncoder"]
 
 #: the feature kinds, in the order of Table 2 (baseline first).
-from .model.defaults import FEATURE_KINDS  # noqa: E402  (re-exported: the kinds, in the order of Table 2)
+from meshvae_lib.model.defaults import FEATURE_KINDS  # noqa: E402  (re-exported: the kinds, in the order of Table 2)
 
 
 def _unpack(vertices, faces=None):
@@ -49,7 +49,7 @@ class FeatureExtractor:
     Parameters
     ----------
     kind : "rimd" | "aligned" | "coords"
-    layout : RIMD layout, "paper" (K = 6V + 6E) or "compact" (see :mod:`meshvae_lib.rimd`).
+    layout : RIMD layout, "paper" (K = 6V + 6E) or "compact" (see :mod:`meshvae_lib.geometry.rimd`).
     reference_index : which mesh of the training collection is the reference (default: the first).
 
     Attributes (after :meth:`fit`)
@@ -89,7 +89,7 @@ class FeatureExtractor:
         self._reconstructor = None
         self._encoder = None
         if self.kind == "rimd":
-            from .rimd import RIMDLayout
+            from meshvae_lib.geometry.rimd import RIMDLayout
 
             self.n_features_ = int(RIMDLayout(self.faces_, len(self.reference_), layout=self.layout).K)
         else:
@@ -119,7 +119,7 @@ class FeatureExtractor:
         self.check_compatible(V, F)
         if self.kind == "rimd":
             if getattr(self, "_encoder", None) is None:
-                from .rimd import RIMDEncoder
+                from meshvae_lib.geometry.rimd import RIMDEncoder
 
                 self._encoder = RIMDEncoder(self.reference_, self.faces_, layout=self.layout)
             X = np.asarray(self._encoder.transform(V), dtype=np.float64).reshape(len(V), -1)
@@ -147,7 +147,7 @@ class FeatureExtractor:
             raise ValueError(f"feature rows must have shape (N, {self.n_features_}), got {X.shape}")
         if self.kind == "rimd":
             if self._reconstructor is None:
-                from .reconstruction import RIMDReconstructor
+                from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 
                 self._reconstructor = RIMDReconstructor(self.reference_, self.faces_, layout=self.layout)
             V = np.asarray(self._reconstructor.reconstruct(X2), dtype=np.float64).reshape(len(X2), -1, 3)

@@ -5,7 +5,7 @@ For vertex ``i`` with one-ring ``N_i``, ``T_i`` minimises (Eq. 1)::
     E(T_i) = sum_{j in N_i} c_ij |e'_ij - T_i e_ij|^2  +  w_n |m'_i - T_i m_i|^2
 
 with ``e_ij = p_i - p_j`` on the reference mesh, ``e'_ij`` on the deformed one, ``c_ij`` the clamped
-cotangent weights (:mod:`meshvae_lib.cotangent`). The second term is the reference implementation's
+cotangent weights (:mod:`meshvae_lib.geometry.cotangent`). The second term is the reference implementation's
 extra "edge" along the vertex normal: ``m_i = l n_i`` with ``n`` the unit area-weighted vertex
 normal and ``l = NORMAL_EDGE_SCALE x mean edge length`` of the reference, and ``m'_i = l'_i n'_i``
 on the deformed mesh with ``l'_i = l sqrt(a'_i / a_i)`` (``a`` the local one-ring area), so that
@@ -22,7 +22,7 @@ and for pure Eq. 1 (``normal_term=False``) on curved one-rings; a flat one-ring 
 ``A_i`` depends only on the reference, so :class:`DeformationGradientOperator` precomputes
 ``A_i^{-1}`` and one sparse matrix ``K`` (``3 n x n``) with ``sum_j c_ij e'_ij (A_i^{-1} e_ij)^T = K p'``
 (the same for each coordinate); a batch of deformed meshes then costs one sparse product and the
-deformed normals. ``T_i`` is linear in ``(p', m')``, which :mod:`meshvae_lib.reconstruction` uses
+deformed normals. ``T_i`` is linear in ``(p', m')``, which :mod:`meshvae_lib.geometry.reconstruction` uses
 for its exact inverse.
 """
 
@@ -31,10 +31,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from . import tolerances as tol
-from .cotangent import cotangent_weights
-from .rotations import from_soa
-from .topology import _check_positions, directed_edges, edge_index, edges, vertex_normal_sums
+from meshvae_lib import tolerances as tol
+from meshvae_lib.geometry.cotangent import cotangent_weights
+from meshvae_lib.geometry.rotations import from_soa
+from meshvae_lib.geometry.topology import _check_positions, directed_edges, edge_index, edges, vertex_normal_sums
 
 __all__ = ["DeformationGradientOperator", "deformation_gradients"]
 
@@ -52,7 +52,7 @@ class DeformationGradientOperator:
         pure Eq. 1 and fails (``ValueError``) at vertices whose one-ring is flat.
     clamp : bool
         Clamp the cotangent weights from below (default, see
-        :func:`meshvae_lib.cotangent.cotangent_weights`). ``False`` uses the raw weights of Eq. 1,
+        :func:`meshvae_lib.geometry.cotangent.cotangent_weights`). ``False`` uses the raw weights of Eq. 1,
         which are negative across edges opposite obtuse angles and can make ``A_i`` indefinite
         (for teaching and comparison; notebook 01 shows what goes wrong).
 
@@ -61,9 +61,9 @@ class DeformationGradientOperator:
     n_vertices : int
     faces : (n_faces, 3) int64
     edges : (n_edges, 2) int64
-        Undirected edges (:func:`meshvae_lib.topology.edges`).
+        Undirected edges (:func:`meshvae_lib.geometry.topology.edges`).
     directed : (2 n_edges, 2) int64
-        Directed edges ``(i, j)`` sorted by ``i`` (:func:`meshvae_lib.topology.directed_edges`).
+        Directed edges ``(i, j)`` sorted by ``i`` (:func:`meshvae_lib.geometry.topology.directed_edges`).
     weights : (n_edges,) float64
         Cotangent weights ``c_ij`` (clamped unless ``clamp=False``).
     normal_length : float

@@ -32,7 +32,7 @@ from typing import Callable
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.alignment import rigid_align
+from meshvae_lib.geometry.alignment import rigid_align
 
 __all__ = [
     "linear_steps",
@@ -198,7 +198,7 @@ class LatentPath:
 
 
 def _mesh_edges(F: np.ndarray) -> np.ndarray:
-    from meshvae_lib.topology import edges
+    from meshvae_lib.geometry.topology import edges
 
     return edges(F)
 

@@ -25,7 +25,7 @@ Positions (``method=``):
   again. Not an exact inverse: per-vertex ``T_i`` are not integrable in general.
 - ``"exact"`` (default): the feature extraction is inverted exactly. ``T_i`` is linear in the
   deformed positions ``p'`` and the deformed normal edges ``m'`` (see
-  :mod:`meshvae_lib.deformation_gradient`): ``T_i = (K p')_i^T + m'_i h_i^T``. Taking both as
+  :mod:`meshvae_lib.geometry.deformation_gradient`): ``T_i = (K p')_i^T + m'_i h_i^T``. Taking both as
   unknowns and minimising ``sum_i |T_i(p', m') - R_i S_i|_F^2``, the ``m'_i`` drop out in closed
   form (projection orthogonal to ``h_i``), leaving one sparse symmetric system ``M p' = r`` in the
   positions, the same matrix for the three coordinates and for every mesh. On generic meshes exact
@@ -52,18 +52,18 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 from scipy.sparse.linalg import splu
 
-from . import tolerances as tol
-from .alignment import rigid_align
-from .deformation_gradient import DeformationGradientOperator
-from .rimd import RIMDLayout
-from .rotations import _exp_soa, _polar_rs_soa, _quat_from_soa, matmul_soa
-from .topology import edge_index
+from meshvae_lib import tolerances as tol
+from meshvae_lib.geometry.alignment import rigid_align
+from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
+from meshvae_lib.geometry.rimd import RIMDLayout
+from meshvae_lib.geometry.rotations import _exp_soa, _polar_rs_soa, _quat_from_soa, matmul_soa
+from meshvae_lib.geometry.topology import edge_index
 
 __all__ = ["METHODS", "ROTATION_RECOVERY", "RIMDReconstructor"]
 
 logger = logging.getLogger(__name__)
 
-from .model.defaults import RECONSTRUCTION_METHODS as METHODS, ROTATION_RECOVERY  # noqa: E402  (re-exported)
+from meshvae_lib.model.defaults import RECONSTRUCTION_METHODS as METHODS, ROTATION_RECOVERY  # noqa: E402  (re-exported)
 #: permutation of the 9 SoA entries that transposes a 3x3 matrix.
 _TRANSPOSE = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
 
@@ -108,7 +108,7 @@ class RIMDReconstructor:
         Position solve, see the module docstring. ``"exact"`` (default) inverts the extraction;
         ``"paper"`` minimises Eq. 1.
     layout : {"paper", "compact"}
-        Feature layout (:class:`meshvae_lib.rimd.RIMDLayout`).
+        Feature layout (:class:`meshvae_lib.geometry.rimd.RIMDLayout`).
     rotations : {"global", "bfs"}
         Rotation recovery, see the module docstring. ``"global"`` (default) is robust to noise.
     iterations : int, optional

@@ -1,12 +1,12 @@
 """Training the mesh VAE: seeded, repeatable, with a progress bar and a per-epoch history.
 
-:func:`train_vae` trains a :class:`~meshvae_lib.vae.MeshVAE` on rows of *normalised* features
+:func:`train_vae` trains a :class:`~meshvae_lib.model.vae.MeshVAE` on rows of *normalised* features
 (Eq. 3) with Adam (lr 1e-3, the fused implementation: about 4x faster on a CPU than the default)
 and the loss of Eq. 4. Everything random (initial weights, shuffling, the reparameterisation noise)
 comes from ``config.seed``: the same seed gives bit-identical weights on a CPU.
 
 The higher-level entry point, from a mesh collection to a model that decodes meshes, is
-:meth:`meshvae_lib.checkpoint.MeshVAEModel.fit`.
+:meth:`meshvae_lib.model.checkpoint.MeshVAEModel.fit`.
 """
 
 from __future__ import annotations
@@ -18,16 +18,16 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import torch
 
-from .tolerances import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR,
+from meshvae_lib.tolerances import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR,
                          EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, NORMALIZE_A, PCA_FEATURE_RANGE, PCA_INIT_RTOL,
                          VALIDATION_EVERY)
-from .vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
+from meshvae_lib.model.vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
 
 __all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device",
            "pad_sigma_object", "pca_network", "INIT_MODES"]
 
 #: how :func:`train_vae` initialises a new network.
-from .model.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
+from meshvae_lib.model.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
 
 logger = logging.getLogger(__name__)
 
@@ -64,7 +64,7 @@ class TrainConfig:
         padded with 1 by :func:`pad_sigma_object`.
     prior_form : how sigma_object enters the latent cost, "exact" (the KL to N(0, diag
         sigma_object^2)) or "sibling" (the authors' sibling-code formula, which makes the chosen
-        dimensions carry the dominant variation; see :func:`~meshvae_lib.vae.kl_divergence`).
+        dimensions carry the dominant variation; see :func:`~meshvae_lib.model.vae.kl_divergence`).
     seed : seeds initial weights, shuffling and sampling.
     device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
     progress : show a tqdm progress bar (terminal or notebook).
@@ -83,7 +83,7 @@ class TrainConfig:
         initialisation on the K features (the paper's network); so do conditional networks, whose
         use of the condition has to be learned.
     feature_range : half-width a of the normalised range (Eq. 3) that
-        :class:`~meshvae_lib.checkpoint.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
+        :class:`~meshvae_lib.model.checkpoint.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
         PCA-initialised networks, the paper's 0.9 otherwise.
     early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
         there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
@@ -93,7 +93,7 @@ class TrainConfig:
         number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
     validation_every, patience : see ``early_stopping``.
     feature_scale : "component" (the paper's Eq. 3) or "shared" (one half-width for all components,
-        see :class:`~meshvae_lib.normalization.FeatureNormalizer`). None: "shared" for coordinate
+        see :class:`~meshvae_lib.model.normalization.FeatureNormalizer`). None: "shared" for coordinate
         features (``"coords"``, ``"aligned"``) of PCA-initialised networks, "component" otherwise.
     """
 
@@ -128,7 +128,7 @@ class TrainConfig:
         return PCA_FEATURE_RANGE if pca else NORMALIZE_A
 
     def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
-        """How :class:`~meshvae_lib.checkpoint.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
+        """How :class:`~meshvae_lib.model.checkpoint.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
         if self.feature_scale is not None:
             return self.feature_scale
         pca = self.uses_pca_init() if pca is None else pca

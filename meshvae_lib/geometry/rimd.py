@@ -32,9 +32,9 @@ import logging
 
 import numpy as np
 
-from .deformation_gradient import DeformationGradientOperator
-from .rotations import _polar_rs_soa, _quat_from_soa, _relative_log_quat
-from .topology import _check_faces, directed_edges, edge_index, edges
+from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
+from meshvae_lib.geometry.rotations import _polar_rs_soa, _quat_from_soa, _relative_log_quat
+from meshvae_lib.geometry.topology import _check_faces, directed_edges, edge_index, edges
 
 __all__ = [
     "LAYOUTS", "S_ENTRIES", "RIMDLayout", "RIMDEncoder", "rimd_features", "save_features",
@@ -44,7 +44,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 #: the two feature layouts.
-from .model.defaults import LAYOUTS  # noqa: E402  (re-exported)
+from meshvae_lib.model.defaults import LAYOUTS  # noqa: E402  (re-exported)
 #: the 6 stored entries (row, column) of each symmetric S_i, in feature order.
 S_ENTRIES = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 _S_FLAT = np.array([3 * a + b for a, b in S_ENTRIES])

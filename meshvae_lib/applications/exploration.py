@@ -24,8 +24,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.alignment import rigid_transform
-from meshvae_lib.evaluation import per_vertex_error
+from meshvae_lib.geometry.alignment import rigid_transform
+from meshvae_lib.model.evaluation import per_vertex_error
 
 __all__ = [
     "exploration_sigma_object",

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import tolerances as tol
-from .topology import _check_positions, face_edge_indices, edges
+from meshvae_lib import tolerances as tol
+from meshvae_lib.geometry.topology import _check_positions, face_edge_indices, edges
 
 __all__ = ["corner_cotangents", "cotangent_weights"]
 
@@ -70,7 +70,7 @@ def cotangent_weights(V, F, clamp: bool = True) -> np.ndarray:
     Returns
     -------
     c : (n_edges,) float64
-        Aligned with :func:`meshvae_lib.topology.edges`. Boundary edges have one term only.
+        Aligned with :func:`meshvae_lib.geometry.topology.edges`. Boundary edges have one term only.
     """
     V, F = _check_positions(V, F)
     cot = corner_cotangents(V, F)

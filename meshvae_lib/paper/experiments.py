@@ -268,7 +268,7 @@ def _stable_vae_class(sigmoid_output: bool = False):
     """
     import torch
 
-    from meshvae_lib.vae import MeshVAE
+    from meshvae_lib.model.vae import MeshVAE
 
     class StableMeshVAE(MeshVAE):
         def encode(self, x, c=None):
@@ -304,8 +304,8 @@ def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_ex
     see ``vae.kl_divergence``. ``hidden``, ``alpha``, ``seed``: override the defaults (the feature
     kind's ``default_hidden``, the paper's alpha = 1e6, the settings' seed).
     """
-    from meshvae_lib.checkpoint import MeshVAEModel
-    from meshvae_lib.training import TrainConfig, default_hidden, holdout_mask
+    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.training import TrainConfig, default_hidden, holdout_mask
 
     hidden = default_hidden(features, "random") if hidden is None else tuple(int(h) for h in hidden)
     alpha = tol.DEFAULT_ALPHA if alpha is None else float(alpha)
@@ -331,7 +331,7 @@ def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_ex
 
 
 def _heldout_error(model, coll: _Data) -> dict:
-    from meshvae_lib.evaluation import evaluate_model
+    from meshvae_lib.model.evaluation import evaluate_model
 
     return evaluate_model(model, coll, held_out_only=True)
 
@@ -539,7 +539,7 @@ def _train_bce(P_train, P_val, latent_dim: int, epochs: int, batch_size: int, se
     import torch
     import torch.nn.functional as Fnn
 
-    from meshvae_lib.vae import kl_divergence
+    from meshvae_lib.model.vae import kl_divergence
 
     x = torch.as_tensor(np.asarray(P_train, dtype=np.float32))
     n, k = x.shape
@@ -605,7 +605,7 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
         P_hat = net.decode(mu).double().numpy()
     ext, norm = mse_model.extractor_, mse_model.normalizer_
     V_hat = ext.inverse_transform(norm.inverse_transform(from_p(P_hat)))
-    from meshvae_lib.evaluation import per_vertex_error
+    from meshvae_lib.model.evaluation import per_vertex_error
 
     bce_err = float(np.mean(per_vertex_error(V_hat, coll.vertices[mask])))
     mse_hist = [h["mse"] for h in mse_model.history_]
@@ -640,13 +640,13 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     weight ``alpha`` and internal layers ``hidden``, once per seed; its embedding is the first two
     encoder means and its row is the seed with the median AUC (all seeds' AUCs are in the notes and
     in ``data["seed_aucs"]``). PCA, NPE (k = 25) and t-SNE (perplexity 30) embed the same
-    normalised RIMD feature rows the VAE sees. Relevance: see :mod:`meshvae_lib.embedding`
+    normalised RIMD feature rows the VAE sees. Relevance: see :mod:`meshvae_lib.applications.embedding`
     ("each": per label column, averaged).
 
     Extra rows: ``compare_exact`` -- the same model with the exact KL; ``compare_paper_defaults`` --
     the sibling form with the paper's general settings (alpha = 1e6, no internal layer).
     """
-    from meshvae_lib import embedding as emb
+    from meshvae_lib.applications import embedding as emb
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
@@ -731,7 +731,7 @@ def generation_table(collection: str = "scape", n: int = 8, conditional_collecti
     (on ``condition_column``), the share of generated meshes whose nearest training mesh carries
     the asked label, against the unconditional model's share.
     """
-    from meshvae_lib.generation import generate
+    from meshvae_lib.applications.generation import generate
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
@@ -785,8 +785,8 @@ def interpolation_table(collection: str = "jumping", pair=None, n_steps: int = 9
     space). Also interpolates between two generated meshes. Reports self-intersections and
     edge-length distortion against the nearest training mesh for every step.
     """
-    from meshvae_lib import interpolation as itp
-    from meshvae_lib.rimd import rimd_features
+    from meshvae_lib.applications import interpolation as itp
+    from meshvae_lib.geometry.rimd import rimd_features
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
@@ -840,7 +840,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
     dimensions 1-2 and a second level over 3-4 with 1-2 fixed at ``second_level_point``, and sweeps
     each of ``dims`` alone, measuring height, supporting leg, arm height and facing direction.
     """
-    from meshvae_lib import exploration as ex
+    from meshvae_lib.applications import exploration as ex
 
     s = _settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)

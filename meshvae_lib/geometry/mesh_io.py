@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import tolerances as tol
+from meshvae_lib import tolerances as tol
 
 __all__ = [
     "MESH_SUFFIXES",
@@ -140,7 +140,7 @@ def validate_mesh(V, F, *, name: str = "mesh", allow_degenerate: bool = False) -
     allow_degenerate : bool
         Accept zero-area faces (area below ``DEGENERATE_AREA_RTOL`` times the squared mean edge
         length). The geometry core copes with them (their cotangent weights fall back to 1, see
-        :mod:`meshvae_lib.cotangent`), but they usually signal a broken file.
+        :mod:`meshvae_lib.geometry.cotangent`), but they usually signal a broken file.
 
     Raises
     ------
@@ -185,7 +185,7 @@ def validate_mesh(V, F, *, name: str = "mesh", allow_degenerate: bool = False) -
         k = np.flatnonzero(~used)
         raise ValueError(
             f"{name}: {len(k)} unreferenced vertices (no face uses them; first: {k[:5].tolist()}); "
-            "remove them with meshvae_lib.mesh_io.remove_unreferenced_vertices"
+            "remove them with meshvae_lib.geometry.mesh_io.remove_unreferenced_vertices"
         )
     if not allow_degenerate:
         Vf = V.astype(np.float64)

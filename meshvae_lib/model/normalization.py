@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tolerances import NORMALIZE_A, NORMALIZE_EPS
+from meshvae_lib.tolerances import NORMALIZE_A, NORMALIZE_EPS
 
 __all__ = ["FeatureNormalizer", "SCALES"]
 

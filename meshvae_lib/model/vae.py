@@ -10,7 +10,7 @@ decoder one linear map D -> K, so there are no internal layers.
 Input projection (``input_rank = r > 0``, a departure from the paper, issue 12): the encoder does
 not see the K features themselves but their r whitened principal coefficients
 ``(x - input_mean) @ input_basis.T``, a fixed linear map onto the span of the training features
-(set by :func:`meshvae_lib.training.pca_network`, stored in the checkpoint as buffers). On real
+(set by :func:`meshvae_lib.model.training.pca_network`, stored in the checkpoint as buffers). On real
 collections 4-35% of a held-out mesh's (centred) feature energy lies outside the span of the
 training meshes; a K-wide encoder trained with Adam gives those directions arbitrary weights
 (Adam's per-weight steps leave the span), and held-out meshes get arbitrary latent codes.
@@ -38,7 +38,7 @@ from typing import Sequence
 import torch
 from torch import nn
 
-from .tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_LOGIT_MIN, SIGMA_MAX
+from meshvae_lib.tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_LOGIT_MIN, SIGMA_MAX
 
 __all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear", "PRIOR_FORMS"]
 
@@ -252,7 +252,7 @@ class MeshVAE(nn.Module):
         return self.decode(z, c), mu, sigma
 
 
-from .model.defaults import PRIOR_FORMS  # noqa: E402  (re-exported)
+from meshvae_lib.model.defaults import PRIOR_FORMS  # noqa: E402  (re-exported)
 
 
 def kl_divergence(
