@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from geometry_fixtures import bumpy, grid, icosphere, random_rotation, tube, twist_bend
 
-from meshvae_lib import tolerances as tol
+from meshvae_lib import defaults as hp
 from meshvae_lib.geometry.cotangent import cotangent_weights
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator, deformation_gradients
 from meshvae_lib.geometry.topology import edge_index, edges, one_rings, vertex_normal_sums
@@ -17,7 +17,7 @@ def _naive(V0, V, F, normal_term=True):
     E = edges(F)
     c = cotangent_weights(V0, F)
     indptr, ring = one_rings(F, len(V0))
-    l = tol.NORMAL_EDGE_SCALE * np.mean(np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1))
+    l = hp.NORMAL_EDGE_SCALE * np.mean(np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1))
     s0, s1 = vertex_normal_sums(V0, F), vertex_normal_sums(V, F)
     out = []
     for i in range(len(V0)):
@@ -30,7 +30,7 @@ def _naive(V0, V, F, normal_term=True):
             n0, n1 = np.linalg.norm(s0[i]), np.linalg.norm(s1[i])
             rows_a.append(l * s0[i] / n0)
             rows_b.append(l * np.sqrt(n1 / n0) * s1[i] / n1)
-            wts.append(tol.NORMAL_EDGE_WEIGHT)
+            wts.append(hp.NORMAL_EDGE_WEIGHT)
         sw = np.sqrt(np.array(wts))[:, None]
         # minimise sum w |b - T a|^2  <=>  (sw a) T^T = (sw b)
         Tt, *_ = np.linalg.lstsq(sw * np.array(rows_a), sw * np.array(rows_b), rcond=None)

@@ -9,7 +9,7 @@ from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.geometry.topology import edges
 from meshvae_lib.model.training import default_hidden
-from meshvae_lib.tolerances import HIDDEN_COORDS
+from meshvae_lib.defaults import HIDDEN_COORDS
 
 
 def grid_collection(n=6, seed=0, nx=6, ny=4):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.tolerances import NORMALIZE_A, NORMALIZE_EPS
+from meshvae_lib.tolerances import NORMALIZE_EPS
+from meshvae_lib.defaults import NORMALIZE_A
 
 
 def test_range_is_minus_a_to_a_per_component(rng):

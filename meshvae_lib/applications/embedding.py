@@ -33,6 +33,7 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 import scipy.linalg
 
+from meshvae_lib import defaults as hp
 from meshvae_lib import tolerances as tol
 
 __all__ = [
@@ -55,7 +56,7 @@ def embedding_sigma_object(latent_dim: int, n_embedded: int = 2) -> np.ndarray:
     Returns
     -------
     sigma_object : (latent_dim,) float64
-        ``tolerances.EMBEDDING_SIGMA_SMALL`` (0.1) for the first ``n_embedded`` dimensions, 1 for
+        ``defaults.EMBEDDING_SIGMA_SMALL`` (0.1) for the first ``n_embedded`` dimensions, 1 for
         the rest.
     """
     if int(latent_dim) < int(n_embedded) or int(n_embedded) < 1:
@@ -63,7 +64,7 @@ def embedding_sigma_object(latent_dim: int, n_embedded: int = 2) -> np.ndarray:
             f"need latent_dim >= n_embedded >= 1, got latent_dim={latent_dim}, n_embedded={n_embedded}"
         )
     s = np.ones(int(latent_dim), dtype=np.float64)
-    s[: int(n_embedded)] = tol.EMBEDDING_SIGMA_SMALL
+    s[: int(n_embedded)] = hp.EMBEDDING_SIGMA_SMALL
     return s
 
 
@@ -153,7 +154,7 @@ class NeighborhoodPreservingEmbedding:
     def __init__(
         self,
         n_components: int = 2,
-        n_neighbors: int = tol.NPE_N_NEIGHBORS,
+        n_neighbors: int = hp.NPE_N_NEIGHBORS,
         reg: float = tol.NPE_REG,
         reg_eig: float = tol.NPE_REG_EIG,
     ):
@@ -213,7 +214,7 @@ class NeighborhoodPreservingEmbedding:
         return self.fit(X).transform(X)
 
 
-def npe_embedding(X, n_components: int = 2, n_neighbors: int = tol.NPE_N_NEIGHBORS) -> np.ndarray:
+def npe_embedding(X, n_components: int = 2, n_neighbors: int = hp.NPE_N_NEIGHBORS) -> np.ndarray:
     """NPE embedding (deterministic), ``X : (n, d)`` -> ``(n, n_components)`` float64."""
     return NeighborhoodPreservingEmbedding(n_components, n_neighbors).fit_transform(X)
 
@@ -232,9 +233,9 @@ def pca_embedding(X, n_components: int = 2, seed: int = 0) -> np.ndarray:
 def tsne_embedding(
     X,
     n_components: int = 2,
-    perplexity: float = tol.TSNE_PERPLEXITY,
+    perplexity: float = hp.TSNE_PERPLEXITY,
     seed: int = 0,
-    pca_dims: int | None = tol.TSNE_PCA_DIMS,
+    pca_dims: int | None = hp.TSNE_PCA_DIMS,
 ) -> np.ndarray:
     """t-SNE embedding via scikit-learn (Sec. 5.4: perplexity 30), ``(n, d)`` -> ``(n, n_components)``.
 

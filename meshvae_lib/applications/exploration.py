@@ -23,7 +23,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from meshvae_lib import tolerances as tol
+from meshvae_lib import defaults as hp
 from meshvae_lib.geometry.alignment import rigid_transform
 from meshvae_lib.model.evaluation import per_vertex_error
 
@@ -47,7 +47,7 @@ HUMANOID_MEASUREMENTS = ("height", "support", "arm_height", "facing")
 
 def exploration_sigma_object(latent_dim: int) -> np.ndarray:
     """The paper's exploration prior: (0.1, 0.1, 0.5, 0.5, 1, ..., 1), shape (latent_dim,) float64."""
-    head = np.asarray(tol.EXPLORATION_SIGMA_OBJECT, dtype=np.float64)
+    head = np.asarray(hp.EXPLORATION_SIGMA_OBJECT, dtype=np.float64)
     if int(latent_dim) < head.size:
         raise ValueError(f"latent_dim must be at least {head.size}, got {latent_dim}")
     return np.concatenate([head, np.ones(int(latent_dim) - head.size)])
@@ -59,7 +59,7 @@ def _latent_dim(model) -> int:
 
 
 def latent_grid(base, dims: Sequence[int] = (0, 1), values_a=None, values_b=None, n: int = 5,
-                value_range=tol.EXPLORATION_RANGE) -> np.ndarray:
+                value_range=hp.EXPLORATION_RANGE) -> np.ndarray:
     """Latent vectors on a 2D grid: ``base`` with dimensions ``dims`` replaced by grid values.
 
     Parameters
@@ -108,7 +108,7 @@ class ExplorationGrid:
 
 
 def explore(model, dims: Sequence[int] = (0, 1), base=None, n: int = 5,
-            value_range=tol.EXPLORATION_RANGE) -> ExplorationGrid:
+            value_range=hp.EXPLORATION_RANGE) -> ExplorationGrid:
     """Decode an ``n x n`` grid over two latent dimensions (paper Fig. 8).
 
     Parameters
@@ -306,7 +306,7 @@ class DimensionEffects:
 
 
 def dimension_effects(model, measure: Callable[[np.ndarray], dict], dims: Sequence[int] = (0, 1, 2, 3),
-                      base=None, n_values: int = 9, value_range=tol.EXPLORATION_RANGE,
+                      base=None, n_values: int = 9, value_range=hp.EXPLORATION_RANGE,
                       reference_vertices=None) -> DimensionEffects:
     """Sweep each latent dimension alone over ``value_range`` and measure the decoded meshes.
 
@@ -354,7 +354,7 @@ def dimension_effects(model, measure: Callable[[np.ndarray], dict], dims: Sequen
 
 
 def dimension_displacement(model, dims: Sequence[int] | None = None, base=None,
-                           value_range=tol.EXPLORATION_RANGE, reference_vertices=None) -> np.ndarray:
+                           value_range=hp.EXPLORATION_RANGE, reference_vertices=None) -> np.ndarray:
     """How far each latent dimension moves the body: the mean vertex distance between the meshes
     decoded at the two ends of ``value_range`` (the others at ``base``), after rigid alignment.
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from meshvae_lib.model.defaults import LAYOUTS
+from meshvae_lib.defaults import LAYOUTS
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)

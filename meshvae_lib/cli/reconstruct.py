@@ -7,7 +7,7 @@ import logging
 import sys
 from pathlib import Path
 
-from meshvae_lib.model.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+from meshvae_lib.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
 
 logger = logging.getLogger(__name__)
 

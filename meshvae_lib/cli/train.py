@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import logging
 
-from meshvae_lib.model.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
-from meshvae_lib.tolerances import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
+from meshvae_lib.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
 from . import add_allow_degenerate
 
 logger = logging.getLogger(__name__)

@@ -28,8 +28,7 @@ from pathlib import Path
 
 from meshvae_lib.applications.embedding import embedding_sigma_object
 from meshvae_lib.applications.exploration import exploration_sigma_object
-from meshvae_lib.tolerances import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN,
-                                    EMBEDDING_SEEDS)
+from meshvae_lib.defaults import CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN, EMBEDDING_SEEDS
 
 logger = logging.getLogger(__name__)
 

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from meshvae_lib import tolerances as tol
+from meshvae_lib import defaults as hp
 from meshvae_lib.geometry.cotangent import cotangent_weights
 from meshvae_lib.geometry.rotations import from_soa
 from meshvae_lib.geometry.topology import _check_positions, directed_edges, edge_index, edges, vertex_normal_sums
@@ -97,7 +97,7 @@ class DeformationGradientOperator:
         c = self.weights[edge_index(self.edges, D[:, 0], D[:, 1])]  # (2E,)
         e = V0[D[:, 0]] - V0[D[:, 1]]  # e_ij = p_i - p_j, (2E, 3)
         lengths = np.linalg.norm(V0[self.edges[:, 0]] - V0[self.edges[:, 1]], axis=1)
-        self.normal_length = float(tol.NORMAL_EDGE_SCALE * lengths.mean())
+        self.normal_length = float(hp.NORMAL_EDGE_SCALE * lengths.mean())
         self._normal_sums = vertex_normal_sums(V0, F)
         ns = np.linalg.norm(self._normal_sums, axis=1)
         if np.any(ns <= 0):
@@ -106,7 +106,7 @@ class DeformationGradientOperator:
         self._normal_sum_norms = ns
         self.normals = self._normal_sums / ns[:, None]
         m = self.normal_length * self.normals
-        wn = tol.NORMAL_EDGE_WEIGHT if normal_term else 0.0
+        wn = hp.NORMAL_EDGE_WEIGHT if normal_term else 0.0
         self.normal_term = bool(normal_term)
         outer = c[:, None, None] * e[:, :, None] * e[:, None, :]
         A = np.stack(

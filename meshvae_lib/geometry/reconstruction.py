@@ -63,7 +63,7 @@ __all__ = ["METHODS", "ROTATION_RECOVERY", "RIMDReconstructor"]
 
 logger = logging.getLogger(__name__)
 
-from meshvae_lib.model.defaults import RECONSTRUCTION_METHODS as METHODS, ROTATION_RECOVERY  # noqa: E402  (re-exported)
+from meshvae_lib.defaults import RECONSTRUCTION_METHODS as METHODS, ROTATION_RECOVERY  # noqa: E402  (re-exported)
 #: permutation of the 9 SoA entries that transposes a 3x3 matrix.
 _TRANSPOSE = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
 

@@ -44,7 +44,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 #: the two feature layouts.
-from meshvae_lib.model.defaults import LAYOUTS  # noqa: E402  (re-exported)
+from meshvae_lib.defaults import LAYOUTS  # noqa: E402  (re-exported)
 #: the 6 stored entries (row, column) of each symmetric S_i, in feature order.
 S_ENTRIES = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 _S_FLAT = np.array([3 * a + b for a, b in S_ENTRIES])

@@ -24,7 +24,7 @@ from meshvae_lib.geometry.alignment import rigid_align
 __all__ = ["FEATURE_KINDS", "FeatureExtractor", "ConditionEncoder"]
 
 #: the feature kinds, in the order of Table 2 (baseline first).
-from meshvae_lib.model.defaults import FEATURE_KINDS  # noqa: E402  (re-exported: the kinds, in the order of Table 2)
+from meshvae_lib.defaults import FEATURE_KINDS  # noqa: E402  (re-exported: the kinds, in the order of Table 2)
 
 
 def _unpack(vertices, faces=None):

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from meshvae_lib.tolerances import NORMALIZE_A, NORMALIZE_EPS
+from meshvae_lib.tolerances import NORMALIZE_EPS
+from meshvae_lib.defaults import NORMALIZE_A
 
 __all__ = ["FeatureNormalizer", "SCALES"]
 

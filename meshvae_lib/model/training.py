@@ -18,16 +18,15 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import torch
 
-from meshvae_lib.tolerances import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR,
-                         EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, NORMALIZE_A, PCA_FEATURE_RANGE, PCA_INIT_RTOL,
-                         VALIDATION_EVERY)
+from meshvae_lib.tolerances import PCA_INIT_RTOL
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, NORMALIZE_A, PCA_FEATURE_RANGE, VALIDATION_EVERY
 from meshvae_lib.model.vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
 
 __all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device",
            "pad_sigma_object", "pca_network", "INIT_MODES"]
 
 #: how :func:`train_vae` initialises a new network.
-from meshvae_lib.model.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
+from meshvae_lib.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
 
 logger = logging.getLogger(__name__)
 

@@ -38,7 +38,8 @@ from typing import Sequence
 import torch
 from torch import nn
 
-from meshvae_lib.tolerances import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_LOGIT_MIN, SIGMA_MAX
+from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
 
 __all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear", "PRIOR_FORMS"]
 
@@ -252,7 +253,7 @@ class MeshVAE(nn.Module):
         return self.decode(z, c), mu, sigma
 
 
-from meshvae_lib.model.defaults import PRIOR_FORMS  # noqa: E402  (re-exported)
+from meshvae_lib.defaults import PRIOR_FORMS  # noqa: E402  (re-exported)
 
 
 def kl_divergence(

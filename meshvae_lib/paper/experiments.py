@@ -32,6 +32,7 @@ from typing import Sequence
 
 import numpy as np
 
+from meshvae_lib import defaults as hp
 from meshvae_lib import tolerances as tol
 
 __all__ = [
@@ -105,7 +106,7 @@ class ExperimentSettings:
     min_epochs: int = 20
     max_epochs: int = 600
     batch_size: int = 32
-    latent_dim: int = tol.DEFAULT_LATENT
+    latent_dim: int = hp.DEFAULT_LATENT
     holdout_every: int = 5
     layout: str = "compact"
     seed: int = 0
@@ -308,7 +309,7 @@ def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_ex
     from meshvae_lib.model.training import TrainConfig, default_hidden, holdout_mask
 
     hidden = default_hidden(features, "random") if hidden is None else tuple(int(h) for h in hidden)
-    alpha = tol.DEFAULT_ALPHA if alpha is None else float(alpha)
+    alpha = hp.DEFAULT_ALPHA if alpha is None else float(alpha)
     seed = settings.seed if seed is None else int(seed)
     latent = settings.latent_dim if latent_dim is None else int(latent_dim)
     every = settings.holdout_every if holdout else 0
@@ -529,7 +530,7 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
 # --------------------------------------------------------------------------------------------
 
 
-def _train_bce(P_train, P_val, latent_dim: int, epochs: int, batch_size: int, seed: int, lr=tol.DEFAULT_LR):
+def _train_bce(P_train, P_val, latent_dim: int, epochs: int, batch_size: int, seed: int, lr=hp.DEFAULT_LR):
     """Train the sigmoid-output VAE with binary cross-entropy (summed over features, as DRAW) + KL.
 
     P_train, P_val : (n, K), (m, K) float targets in [0.1, 0.9]. Returns (network, history) where
@@ -549,7 +550,7 @@ def _train_bce(P_train, P_val, latent_dim: int, epochs: int, batch_size: int, se
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     shuffle = torch.Generator().manual_seed(seed + 1)
     noise = torch.Generator().manual_seed(seed + 2)
-    to_eq3 = (2 * tol.NORMALIZE_A) / (tol.BCE_TARGET_RANGE[1] - tol.BCE_TARGET_RANGE[0])
+    to_eq3 = (2 * hp.NORMALIZE_A) / (hp.BCE_TARGET_RANGE[1] - hp.BCE_TARGET_RANGE[0])
     history = []
     for epoch in range(epochs):
         net.train()
@@ -595,9 +596,9 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
     epochs = mse_model.config.epochs
     mask = mse_model.holdout_mask_
     Xn = mse_model.features_of(coll.vertices)  # [-0.9, 0.9] (Eq. 3)
-    lo, hi = tol.BCE_TARGET_RANGE
-    to_p = lambda X: lo + (np.asarray(X) + tol.NORMALIZE_A) * (hi - lo) / (2 * tol.NORMALIZE_A)  # noqa: E731
-    from_p = lambda P: (np.asarray(P) - lo) * (2 * tol.NORMALIZE_A) / (hi - lo) - tol.NORMALIZE_A  # noqa: E731
+    lo, hi = hp.BCE_TARGET_RANGE
+    to_p = lambda X: lo + (np.asarray(X) + hp.NORMALIZE_A) * (hi - lo) / (2 * hp.NORMALIZE_A)  # noqa: E731
+    from_p = lambda P: (np.asarray(P) - lo) * (2 * hp.NORMALIZE_A) / (hi - lo) - hp.NORMALIZE_A  # noqa: E731
     net, hist = _train_bce(to_p(Xn[~mask]), to_p(Xn[mask]), mse_model.network_.latent_dim,
                            epoch_factor * epochs, s.batch_size, s.seed)
     with torch.no_grad():
@@ -630,7 +631,7 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
 @_timed
 def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"), relevance: str = "each",
                     compare_exact: bool = True, compare_paper_defaults: bool = True,
-                    seeds=tol.EMBEDDING_SEEDS, alpha: float = tol.EMBEDDING_ALPHA, hidden=tol.EMBEDDING_HIDDEN,
+                    seeds=hp.EMBEDDING_SEEDS, alpha: float = hp.EMBEDDING_ALPHA, hidden=hp.EMBEDDING_HIDDEN,
                     settings: ExperimentSettings | None = None, quick: bool = False,
                     cache: dict | None = None) -> ExperimentTable:
     """Sec. 5.4: 2D embeddings and their retrieval precision-recall AUC.
@@ -674,7 +675,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
 
     ours, med, model = vae_rows("sibling", alpha, hidden)
     X = model.features_of(coll.vertices)  # the normalised rows every model saw (fitted on all meshes)
-    k = min(tol.NPE_N_NEIGHBORS, len(X) - 1)
+    k = min(hp.NPE_N_NEIGHBORS, len(X) - 1)
     Y = {
         "sigma_object VAE": ours[med][0],
         "t-SNE": emb.tsne_embedding(X, seed=s.seed),
@@ -688,7 +689,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     if compare_exact:
         extra.append(("sigma_object VAE, exact KL", "exact", alpha, hidden))
     if compare_paper_defaults:
-        extra.append(("sigma_object VAE, alpha 1e6, no hidden layer", "sibling", tol.DEFAULT_ALPHA, ()))
+        extra.append(("sigma_object VAE, alpha 1e6, no hidden layer", "sibling", hp.DEFAULT_ALPHA, ()))
     for name, prior, a, h in extra:
         runs, m, _ = vae_rows(prior, a, h)
         Y[name], curves[name] = runs[m]
@@ -834,7 +835,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
     """Sec. 5.5 / Fig. 9: sigma_object = (0.1, 0.1, 0.5, 0.5, 1, ...), what each dimension controls.
 
     The model is trained as the embedding model (sibling-form latent cost, alpha =
-    ``tolerances.EMBEDDING_ALPHA``, hidden layers ``EMBEDDING_HIDDEN``, ``settings.embedding_steps``).
+    ``defaults.EMBEDDING_ALPHA``, hidden layers ``EMBEDDING_HIDDEN``, ``settings.embedding_steps``).
 
     Trains the exploration model on the whole collection, decodes a ``grid x grid`` first level over
     dimensions 1-2 and a second level over 3-4 with 1-2 fixed at ``second_level_point``, and sweeps
@@ -846,7 +847,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
     coll = load_collection(collection, s, cache=cache)
     ep = s.embedding_epochs_for(len(coll.vertices))
     model = _train(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
-                   prior="sibling", alpha=tol.EMBEDDING_ALPHA, hidden=tol.EMBEDDING_HIDDEN, epochs=ep)
+                   prior="sibling", alpha=hp.EMBEDDING_ALPHA, hidden=hp.EMBEDDING_HIDDEN, epochs=ep)
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
     regions = ex.humanoid_regions(rest)
     measure = lambda V: ex.measure_humanoid(V, regions)  # noqa: E731

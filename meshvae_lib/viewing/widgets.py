@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from meshvae_lib.tolerances import LIVE_UPDATE_MAX_MS
+from meshvae_lib.defaults import LIVE_UPDATE_MAX_MS
 from .viewer import MeshViewer, as_mesh_stack
 
 __all__ = ["FramePlayer", "LatentPad", "LatentExplorer", "InterpolationSlider"]
@@ -291,7 +291,7 @@ class LatentExplorer(_Displayable):
     continuous_update : bool or "auto"
         Decode while a slider is dragged (True) or on release (False). ``"auto"`` (default) starts
         continuous and switches to on-release when the median of the last three updates exceeds
-        :data:`~meshvae_lib.tolerances.LIVE_UPDATE_MAX_MS`, so a slow model does not build a
+        :data:`~meshvae_lib.defaults.LIVE_UPDATE_MAX_MS`, so a slow model does not build a
         backlog of stale slider positions.
     titles : list of str, optional
     **viewer_kw

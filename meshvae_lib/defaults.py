@@ -1,0 +1,92 @@
+"""Every hyperparameter default of the library and the allowed values of its string options, in
+one place, as plain constants (importable without numpy or torch, so that the command line lists
+them in ``--help`` without loading the model). Numerical tolerances live in ``tolerances``.
+
+Modules import the names they need from here; values quoted from the paper or from the reference
+implementation say so, values measured here say where.
+"""
+
+# --- option choices ----------------------------------------------------------------------------
+#: feature kinds (the columns of the paper's Table 2; baseline first): ``features.FeatureExtractor``.
+FEATURE_KINDS = ("coords", "aligned", "rimd")
+#: RIMD feature layouts: both directions of every edge (the paper's K), or one (``rimd.RIMDEncoder``).
+LAYOUTS = ("paper", "compact")
+#: how a sigma_object prior enters the latent cost (``vae.kl_divergence``).
+PRIOR_FORMS = ("exact", "sibling")
+#: network initialisations (``training.TrainConfig.init``) and the default.
+INIT_MODES = ("pca", "random")
+DEFAULT_INIT = "pca"
+#: reconstruction methods and rotation recovery (``reconstruction.RIMDReconstructor``).
+RECONSTRUCTION_METHODS = ("exact", "paper")
+ROTATION_RECOVERY = ("global", "bfs")
+
+# --- hyperparameter defaults -------------------------------------------------------------------
+#: length of the extra "normal edge", as a fraction of the mean edge length (reference: 0.3).
+NORMAL_EDGE_SCALE = 0.3
+#: features are mapped to [-a, a].
+NORMALIZE_A = 0.9
+#: deviation output sigma = SIGMA_MAX * sigmoid(x).
+SIGMA_MAX = 2.0
+#: weight of the reconstruction term in Eq. 4.
+DEFAULT_ALPHA = 1e6
+#: default latent size.
+DEFAULT_LATENT = 128
+#: Adam learning rate.
+DEFAULT_LR = 1e-3
+#: slope of the leaky ReLU on internal layers.
+LEAKY_RELU_SLOPE = 0.1
+#: prior deviation of the embedded latent dimensions of the sigma_object model (paper: 0.1).
+EMBEDDING_SIGMA_SMALL = 0.1
+#: reconstruction weight of the embedding and exploration models. The paper's 1e6 ("for most tasks") leaves the
+#: latent cost negligible, so sigma_object changes nothing; 1e3 lets it act (measured on the
+#: Dyna-like collection: docs/applications.md, "Embedding").
+EMBEDDING_ALPHA = 1e3
+#: internal layer of the embedding and exploration models: with none, the encoder mean is a linear map of the
+#: features and the 2D map a linear projection, which cannot beat PCA by much.
+EMBEDDING_HIDDEN = (256,)
+#: weight of the reconstruction term for the course's conditional model (notebook 06): at the paper's 1e6 the
+#: KL term is too weak to push the labels out of z, and a model asked for a motion generated it for 29% of the
+#: samples (5 bodies x 7 motions, 300 vertices, 60 epochs); at 1e3 with a hidden layer and 1000 epochs, 84%
+#: of the motions and 98% of the bodies at 1,464 vertices (nearest-neighbour label of 10 samples per value).
+CONDITIONAL_ALPHA = 1e3
+#: internal layer of the course's conditional model: without one the label only shifts a linear decoder's
+#: output (64% of the motions obeyed at 300 vertices, against 79% with 256 units).
+CONDITIONAL_HIDDEN = (256,)
+#: training seeds of the embedding model; the table reports the median AUC over them.
+EMBEDDING_SEEDS = (0, 1, 2, 3, 4)
+#: neighbours of Neighborhood Preserving Embedding (paper: k = 25).
+NPE_N_NEIGHBORS = 25
+#: t-SNE perplexity (paper: 30).
+TSNE_PERPLEXITY = 30.0
+#: t-SNE inputs are reduced to this many principal components first.
+TSNE_PCA_DIMS = 50
+#: prior deviations of the exploration model: first two, next two, the rest.
+EXPLORATION_SIGMA_OBJECT = (0.1, 0.1, 0.5, 0.5)
+#: browsing range of each explored latent dimension.
+EXPLORATION_RANGE = (-2.0, 2.0)
+#: weight of the extra normal "edge" in the fit of T_i, relative to the cotangent weights
+#: c_ij = cot a + cot b (an equilateral one-ring has c_ij = 1.15).
+NORMAL_EDGE_WEIGHT = 1.0
+#: range the features are mapped to for the sigmoid + binary cross-entropy alternative.
+BCE_TARGET_RANGE = (0.1, 0.9)
+#: training epochs when none are given (enough for 50-200 meshes at batch 32).
+DEFAULT_EPOCHS = 1000
+#: meshes per Adam step.
+DEFAULT_BATCH_SIZE = 32
+#: internal layer sizes for the coordinate baselines of Table 2 with the paper's random start.
+#: With the PCA initialisation (TrainConfig.init="pca") none is better for every kind on the real
+#: collections (docs/vae.md, issue 12): on pcow (every 3rd frame) this default (256, random start)
+#: gave 0.109 held-out for raw coordinates, the PCA-initialised network without internal layers 0.022.
+HIDDEN_COORDS = (256,)
+#: half-width a of the normalised range (Eq. 3) used with the PCA initialisation. The paper's 0.9
+#: puts training values where tanh is strongly curved; a decoder that is linear before the tanh
+#: then interpolates held-out meshes badly (pcow, coordinates: 0.141 held-out at a = 0.9, 0.031 at
+#: 0.5, 0.022 at 0.3, linear PCA 0.020). Networks trained without the PCA initialisation keep 0.9.
+PCA_FEATURE_RANGE = 0.3
+#: early stopping: every this-many-th training mesh is set aside to choose the number of epochs.
+VALIDATION_EVERY = 8
+#: early stopping: stop choosing after this many epochs without a lower validation error.
+EARLY_STOPPING_PATIENCE = 100
+#: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
+#: takes less than this many milliseconds; slower models switch to decoding on release.
+LIVE_UPDATE_MAX_MS = 150.0
