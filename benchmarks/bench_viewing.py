@@ -6,7 +6,7 @@ decode z -> mesh, numpy vertex normals, float32 buffers, and the pythreejs attri
 attached the final zmq send is a no-op, a few hundred microseconds for 2 x 36 KB at 3k vertices).
 
 Decoders:
-- "MeshVAE+RIMD": a real :class:`meshvae_lib.model.checkpoint.MeshVAEModel` (RIMD features, latent 128,
+- "MeshVAE+RIMD": a real :class:`meshvae_lib.model.meshvae_model.MeshVAEModel` (RIMD features, latent 128,
   trained for 2 epochs on 12 meshes of the synthetic "scape" collection: latency does not depend on
   how well it is trained) whose ``decode_latent`` runs the network, the inverse feature
   normalisation and :class:`~meshvae_lib.geometry.reconstruction.RIMDReconstructor`;
@@ -51,7 +51,7 @@ def _real_model(resolution: int):
         from types import SimpleNamespace
 
         from data_synth.registry import make_collection
-        from meshvae_lib.model.checkpoint import MeshVAEModel
+        from meshvae_lib.model.meshvae_model import MeshVAEModel
         from meshvae_lib.model.training import TrainConfig
     except ImportError as err:
         return None, f"real model unavailable ({err})"

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from meshvae_lib.model.checkpoint import MeshVAEModel
+from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
 from meshvae_lib.geometry.mesh_io import MeshCollection
 from meshvae_lib.model.training import TrainConfig, holdout_mask

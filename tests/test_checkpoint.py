@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import torch
 
-from meshvae_lib.model.checkpoint import MeshVAEModel, load_model, save_model
+from meshvae_lib.model.meshvae_model import MeshVAEModel
+from meshvae_lib.model.checkpoint import load_model, write_checkpoint
 from meshvae_lib.geometry.mesh_io import MeshCollection
 from meshvae_lib.model.training import TrainConfig
 
@@ -200,3 +201,25 @@ def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
         model.fit_latent(V, iterations=0)
     with pytest.raises(ValueError, match="z0"):
         model.fit_latent(V, z0=np.zeros((1, 8)))
+
+
+def test_fit_leaves_its_constructor_arguments_and_exposes_the_mesh(collection):
+    model = MeshVAEModel("coords", None, holdout_every=4)
+    model.fit(collection)
+    assert model.config is None and model.train_config_ == TrainConfig()   # defaults used, argument kept
+    np.testing.assert_array_equal(model.reference_vertices, collection.vertices[0])
+    np.testing.assert_array_equal(model.faces, collection.faces)
+    for arr in (model.reference_vertices, model.faces):
+        with pytest.raises(ValueError, match="read-only"):
+            arr[0, 0] = 1
+    with pytest.raises(ValueError, match="not trained yet"):
+        MeshVAEModel().faces
+
+
+def test_generate_returns_the_draws_behind_its_meshes(model):
+    V, z, c = model.generate(3, seed=7, return_latents=True)
+    np.testing.assert_array_equal(z, model.sample_latent(3, seed=7))
+    np.testing.assert_allclose(V, model.decode_latent(z), atol=0)
+    assert c is None and np.array_equal(model.generate(3, seed=7), V)
+    with pytest.raises(ValueError, match="unconditional"):
+        model.generate(2, condition={"mode": "arc"})

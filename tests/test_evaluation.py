@@ -139,7 +139,7 @@ def test_default_rimd_model_generalises_better_than_coordinate_pca_and_the_paper
     and against the paper's training (random start, all epochs) on the same held-out meshes.
     Measured (seed 0, 302 vertices, latent 16): default 1.2e-2 (training meshes 8.5e-3), PCA 2.2e-2, paper's training 5.6e-2."""
     from data_synth.registry import make_collection
-    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
     from meshvae_lib.model.evaluation import pca_baseline
     from meshvae_lib.model.training import TrainConfig
 

@@ -37,22 +37,29 @@ def _tiny_collection(n=12, seed=0):
 
 
 def _tiny_model(coll, labels=(), seed=0):
-    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
     from meshvae_lib.model.training import TrainConfig
 
     cfg = TrainConfig(epochs=5, batch_size=4, latent_dim=3, seed=seed, device="cpu", progress=False)
     return MeshVAEModel(features="coords", config=cfg, labels=labels).fit(coll)
 
 
-def test_sample_prior_shape_seed_and_scale():
-    z = gen.sample_prior(20000, 3, sigma_object=[0.1, 0.5, 1.0], seed=4)
+def test_prior_draws_shape_seed_and_scale():
+    """MeshVAEModel.sample_latent draws N(0, diag(sigma_object^2)) with the exact prior form."""
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.model.training import TrainConfig
+
+    cfg = TrainConfig(epochs=2, batch_size=4, latent_dim=3, seed=0, device="cpu", progress=False,
+                      sigma_object=(0.1, 0.5, 1.0), prior_form="exact", init="random")
+    model = MeshVAEModel(features="coords", config=cfg).fit(_tiny_collection())
+    z = model.sample_latent(20000, seed=4)
     assert z.shape == (20000, 3) and z.dtype == np.float64
     np.testing.assert_allclose(z.std(axis=0), [0.1, 0.5, 1.0], rtol=0.03)
     np.testing.assert_allclose(z.mean(axis=0), 0.0, atol=0.03)
-    np.testing.assert_array_equal(gen.sample_prior(5, 3, seed=1), gen.sample_prior(5, 3, seed=1))
-    assert not np.array_equal(gen.sample_prior(5, 3, seed=1), gen.sample_prior(5, 3, seed=2))
-    with pytest.raises(ValueError, match=r"\(3,\)"):
-        gen.sample_prior(5, 3, sigma_object=[1.0, 1.0])
+    np.testing.assert_array_equal(model.sample_latent(5, seed=1), model.sample_latent(5, seed=1))
+    assert not np.array_equal(model.sample_latent(5, seed=1), model.sample_latent(5, seed=2))
+    with pytest.raises(ValueError, match="n must be >= 1, got 0"):
+        model.sample_latent(0)
 
 
 def test_nearest_neighbors_against_brute_force(rng):

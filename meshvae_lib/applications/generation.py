@@ -12,7 +12,9 @@ same and, so that "near" has a scale, also reports the typical distance between 
 its nearest *other* training mesh (``dataset_nn_distance``): a generated mesh much closer to a
 training mesh than that would be a copy.
 
-Public names: ``sample_prior``, ``nearest_neighbors``, ``generate``, ``GenerationResult``.
+Public names: ``generate``, ``GenerationResult``, ``nearest_neighbors``, ``dataset_feature_rows``,
+``condition_agreement``. (Meshes alone, without the comparison: ``MeshVAEModel.generate``; prior
+draws: ``MeshVAEModel.sample_latent``.)
 """
 
 from __future__ import annotations
@@ -21,29 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["sample_prior", "nearest_neighbors", "rimd_feature_rows", "dataset_feature_rows", "generate",
-           "GenerationResult", "condition_agreement"]
-
-
-def sample_prior(n: int, latent_dim: int, sigma_object=None, seed: int = 0) -> np.ndarray:
-    """Draws from the prior ``N(0, diag(sigma_object^2))`` (Sec. 4.4; ``N(0, I)`` when None).
-
-    Parameters
-    ----------
-    n, latent_dim : int >= 1
-    sigma_object : (latent_dim,) positive float or None
-    seed : int
-
-    Returns
-    -------
-    z : (n, latent_dim) float64
-    """
-    if int(n) < 1 or int(latent_dim) < 1:
-        raise ValueError(f"n and latent_dim must be >= 1, got n={n}, latent_dim={latent_dim}")
-    s = np.ones(int(latent_dim)) if sigma_object is None else np.asarray(sigma_object, dtype=np.float64)
-    if s.shape != (int(latent_dim),) or np.any(s <= 0):
-        raise ValueError(f"sigma_object must be ({latent_dim},) positive, got shape {s.shape}")
-    return np.random.default_rng(seed).standard_normal((int(n), int(latent_dim))) * s
+__all__ = ["nearest_neighbors", "dataset_feature_rows", "generate", "GenerationResult", "condition_agreement"]
 
 
 def nearest_neighbors(queries, dataset, chunk: int = 256, exclude_self: bool = False):
@@ -82,15 +62,6 @@ def nearest_neighbors(queries, dataset, chunk: int = 256, exclude_self: bool = F
         index[s : s + chunk] = np.argmin(d2, axis=1)
     distance = np.linalg.norm(Q - D[index], axis=1)
     return index, distance
-
-
-def rimd_feature_rows(reference, vertices, faces) -> np.ndarray:
-    """RIMD features (Eq. 2) of meshes relative to ``reference``: (N, n, 3) -> (N, K) float64."""
-    from meshvae_lib.geometry.rimd import rimd_features
-
-    V = np.asarray(vertices, dtype=np.float64)
-    X = rimd_features(np.asarray(reference, dtype=np.float64), V, np.asarray(faces, dtype=np.int64))
-    return np.asarray(X, dtype=np.float64).reshape(len(V), -1)
 
 
 @dataclass
@@ -156,7 +127,9 @@ def _check_feature_space(feature_space: str) -> None:
 
 def _feature_rows(model, V: np.ndarray, feature_space: str) -> np.ndarray:
     if feature_space == "rimd":
-        return rimd_feature_rows(model.extractor_.reference_, V, model.extractor_.faces_)
+        from meshvae_lib.geometry.rimd import rimd_features
+
+        return np.asarray(rimd_features(model.reference_vertices, V, model.faces), dtype=np.float64).reshape(len(V), -1)
     return np.asarray(model.extractor_.transform(V), dtype=np.float64).reshape(len(V), -1)
 
 
@@ -208,16 +181,7 @@ def generate(
     if int(n) < 1:
         raise ValueError(f"n must be >= 1, got {n}")
     _check_feature_space(feature_space)
-    z = model.sample_latent(int(n), seed=seed)
-    cond = None
-    if model.is_conditional:
-        cond = model.condition_vector(condition, n=int(n), seed=seed)
-        V = model.decode_latent(z, conditions=cond)
-    else:
-        if condition:
-            raise ValueError("this model is unconditional; it takes no condition")
-        V = model.decode_latent(z)
-    V = np.asarray(V, dtype=np.float64).reshape(int(n), -1, 3)
+    V, z, cond = model.generate(int(n), seed=seed, condition=condition, return_latents=True)
     result = GenerationResult(latents=z, vertices=V, conditions=cond)
     if dataset is None:
         return result

@@ -51,7 +51,7 @@ def run(args) -> int:
                          " (meshvae train ... --labels COLUMN)")
     V = model.generate(args.n, seed=args.seed, condition=condition or None)
     labels = {col: np.asarray([val] * args.n) for col, val in condition.items()}
-    out = write_collection(args.output, V, model.extractor_.faces_,
+    out = write_collection(args.output, V, model.faces,
                            names=[f"generated_{i:04d}" for i in range(args.n)], labels=labels or None)
     print(f"wrote {args.n} meshes to {out}")
     return 0

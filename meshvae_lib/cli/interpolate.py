@@ -88,6 +88,6 @@ def run(args) -> int:
         cond = ((1 - t) * c[0] + t * c[1]).astype(np.float32)
     V = model.decode_latent(Z, conditions=cond)
     names = [f"step_{i:03d}" for i in range(args.steps)]
-    out = write_collection(args.output, V, model.extractor_.faces_, names=names)
+    out = write_collection(args.output, V, model.faces, names=names)
     print(f"wrote {args.steps} meshes from {ends[0][2]} to {ends[1][2]} to {out}")
     return 0

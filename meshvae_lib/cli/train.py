@@ -83,7 +83,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.mesh_io import read_collection
     from meshvae_lib.model.training import TrainConfig, default_hidden

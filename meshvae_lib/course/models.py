@@ -2,7 +2,7 @@
 
 Each entry of :data:`COURSE_MODELS` names a ``data_synth`` collection (name, seed, resolution), what
 the lesson needs from the model (features, labels, a sigma_object prior) and a training budget.
-:func:`course_model` returns the fitted :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`: from the
+:func:`course_model` returns the fitted :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`: from the
 cache when an entry with the same key is there, else trained (with a progress bar), written to the
 cache and returned.
 
@@ -48,7 +48,7 @@ class CourseModelSpec:
 
     name : registry key; lesson : the notebook that uses it; collection : a ``data_synth`` name;
     resolution : template vertices (approximate); data_seed : the collection's seed;
-    features, labels, layout, holdout_every : :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`'s
+    features, labels, layout, holdout_every : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`'s
     arguments; config : :class:`~meshvae_lib.model.training.TrainConfig` keywords (the budget: ``epochs``,
     ``latent_dim``, ...; ``progress`` is set by :func:`course_model`); minutes : the measured build
     time on 2 CPU cores, for the message shown before a build; description : one line.
@@ -215,7 +215,7 @@ def is_cached(name: str) -> bool:
 
 def build_model(name: str, progress: bool = True):
     """Train course model ``name`` from scratch (no cache). Returns the fitted MeshVAEModel."""
-    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
 
     spec = get_spec(name)
     model = MeshVAEModel(spec.features, spec.train_config(progress), labels=spec.labels,
@@ -224,7 +224,7 @@ def build_model(name: str, progress: bool = True):
 
 
 def course_model(name: str, progress: bool = True, rebuild: bool = False):
-    """The fitted course model ``name`` (a :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`).
+    """The fitted course model ``name`` (a :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`).
 
     Loaded from the cache when an entry with the current key is there and reads back intact; else
     trained (a progress bar when ``progress``; a log message says how long the build takes),

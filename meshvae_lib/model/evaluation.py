@@ -36,7 +36,7 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
 def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0) -> dict:
     """Reconstruct meshes of ``collection`` (encode to the latent mean, decode) and measure them.
 
-    model : :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`.
+    model : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
     indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
         collection must then be the one it was trained on).

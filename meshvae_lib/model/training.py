@@ -6,7 +6,7 @@ and the loss of Eq. 4. Everything random (initial weights, shuffling, the repara
 comes from ``config.seed``: the same seed gives bit-identical weights on a CPU.
 
 The higher-level entry point, from a mesh collection to a model that decodes meshes, is
-:meth:`meshvae_lib.model.checkpoint.MeshVAEModel.fit`.
+:meth:`meshvae_lib.model.meshvae_model.MeshVAEModel.fit`.
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ class TrainConfig:
         initialisation on the K features (the paper's network); so do conditional networks, whose
         use of the condition has to be learned.
     feature_range : half-width a of the normalised range (Eq. 3) that
-        :class:`~meshvae_lib.model.checkpoint.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
+        :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
         PCA-initialised networks, the paper's 0.9 otherwise.
     early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
         there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
@@ -127,7 +127,7 @@ class TrainConfig:
         return PCA_FEATURE_RANGE if pca else NORMALIZE_A
 
     def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
-        """How :class:`~meshvae_lib.model.checkpoint.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
+        """How :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
         if self.feature_scale is not None:
             return self.feature_scale
         pca = self.uses_pca_init() if pca is None else pca

@@ -305,7 +305,7 @@ def _train(coll: _Data, settings: ExperimentSettings, cache: dict | None, key_ex
     see ``vae.kl_divergence``. ``hidden``, ``alpha``, ``seed``: override the defaults (the feature
     kind's ``default_hidden``, the paper's alpha = 1e6, the settings' seed).
     """
-    from meshvae_lib.model.checkpoint import MeshVAEModel
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
     from meshvae_lib.model.training import TrainConfig, default_hidden, holdout_mask
 
     hidden = default_hidden(features, "random") if hidden is None else tuple(int(h) for h in hidden)

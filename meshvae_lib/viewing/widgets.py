@@ -262,7 +262,7 @@ class LatentExplorer(_Displayable):
     decode : callable or model
         ``decode(z)`` with ``z : (latent_dim,) float64`` returning ``(n_vertices, 3)`` (or
         ``(1, n_vertices, 3)``, or ``(k, n_vertices, 3)`` to show k meshes side by side); an object
-        with a ``decode_latent`` method (e.g. :class:`~meshvae_lib.model.checkpoint.MeshVAEModel`) works too.
+        with a ``decode_latent`` method (e.g. :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`) works too.
     latent_dim : int
     F : (n_faces, 3) int
     dims : sequence of int, optional
