@@ -6,6 +6,7 @@ Used by the Makefile (``make notebooks``, ``make course``, ``make student``, ``m
     python -m meshvae_lib.course html --out build/course notebooks/0*.ipynb
     python -m meshvae_lib.course student --out build/student notebooks/0*.ipynb
     python -m meshvae_lib.course models            # build every missing course model
+    python -m meshvae_lib.course architecture      # regenerate docs/ARCHITECTURE.md's module tables
 """
 
 from __future__ import annotations
@@ -139,6 +140,18 @@ def _cmd_models(args) -> int:
     return 0
 
 
+def _cmd_architecture(args) -> int:
+    from .architecture import update_architecture
+
+    page = Path(args.page)
+    changed = update_architecture(page, check=args.check)
+    if args.check:
+        print(f"{page} is {'stale: run python -m meshvae_lib.course architecture' if changed else 'current'}")
+        return 1 if changed else 0
+    print(f"{'rewrote' if changed else 'unchanged:'} {page}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m meshvae_lib.course", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -164,6 +177,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rebuild", action="store_true", help="train even when cached")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.set_defaults(func=_cmd_models)
+    p = sub.add_parser("architecture", help="regenerate the module tables of docs/ARCHITECTURE.md from the code")
+    p.add_argument("--page", default="docs/ARCHITECTURE.md", help="the page to rewrite (default docs/ARCHITECTURE.md)")
+    p.add_argument("--check", action="store_true", help="only say whether the page is current (exit 1 if stale)")
+    p.set_defaults(func=_cmd_architecture)
     args = parser.parse_args(argv)
     try:
         return args.func(args)
