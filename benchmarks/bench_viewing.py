@@ -102,7 +102,7 @@ def main(argv=None):
     p.add_argument("--no-real", action="store_true", help="only the stand-in decoder")
     args = p.parse_args(argv)
 
-    from meshvae_lib.viewing.widgets import LatentExplorer
+    from meshvae_lib.viewing.explorer import LatentExplorer
 
     rows = []
     notes = []

@@ -87,6 +87,10 @@ PCA_FEATURE_RANGE = 0.3
 VALIDATION_EVERY = 8
 #: early stopping: stop choosing after this many epochs without a lower validation error.
 EARLY_STOPPING_PATIENCE = 100
+#: LatentExplorer coloured by displacement: the colour scale reaches at least this fraction of the
+#: mesh's bounding-box diagonal (at the start every displacement is 0, and a zero-width scale
+#: would show no colour bar worth reading).
+EXPLORER_MIN_DISPLACEMENT = 0.01
 #: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
 #: takes less than this many milliseconds; slower models switch to decoding on release.
 LIVE_UPDATE_MAX_MS = 150.0

@@ -29,17 +29,31 @@ NPE_REG_EIG = 1e-6
 #: principal components with singular value below this fraction of the largest are dropped (NPE).
 NPE_PCA_RTOL = 1e-8
 
-# --- applications: interpolation / implausibility ---------------------------------------------
+# --- geometry: self-intersections (geometry.intersections) -----------------------------------
 #: triangles closer than this fraction of the mean edge length do not count as intersecting
 #: (touching is not crossing).
 SELF_INTERSECTION_RTOL = 1e-9
 #: cross products shorter than this (relative) are treated as parallel axes in the SAT test.
 SAT_PARALLEL_RTOL = 1e-12
+#: broad phase: the grid cell doubles until the triangles' boxes touch at most this many cells
+#: each on average (3 x 3 x 3), so the candidate list stays linear in the number of triangles...
+SELF_INTERSECTION_CELLS_PER_TRIANGLE = 27
+#: ...but it stops growing at this multiple of the starting cell (a mesh of one huge triangle).
+SELF_INTERSECTION_MAX_CELL_GROWTH = 1e6
+
+# --- geometry: divisions by a length that may be exactly zero --------------------------------
+#: floor of a norm, length or scale that is divided by, so that an exact zero (a zero-area
+#: vertex neighbourhood, a zero rotation vector, a constant coordinate) gives a finite result;
+#: far below any length a float64 mesh can hold, it changes no other value.
+DIVISION_FLOOR = 1e-300
 
 # --- geometry core: deformation gradients, rotations, reconstruction (issue 2) ----------------
 #: polar decomposition: Newton iterations at most, of which the first few are scaled (Higham 1986).
 POLAR_MAX_ITERATIONS = 40
 POLAR_SCALED_ITERATIONS = 8
+#: ...and scaling stops earlier once every scale factor g is within this of 1 (it no longer
+#: speeds convergence up; the unscaled steps then have the quadratic convergence test below).
+POLAR_SCALING_OFF = 1e-3
 #: stop Newton when no entry changed by more than this in an unscaled step: convergence is
 #: quadratic, so the result is then orthogonal to ~1e-16.
 POLAR_CONVERGENCE = 1e-9
@@ -47,6 +61,10 @@ POLAR_CONVERGENCE = 1e-9
 POLAR_SINGULAR_RTOL = 1e-12
 #: a Newton result farther than this from orthogonal is redone by SVD.
 POLAR_ORTHOGONALITY_TOL = 1e-10
+#: deformation gradients: the one-ring matrix A_i (sum_j c_ij e_ij e_ij^T + normal term) counts as
+#: singular when |det A_i| is below this times |A_i|_F^3 (a flat one-ring without normal term, a
+#: degenerate reference mesh); the operator then refuses the reference mesh.
+ONE_RING_SINGULAR_RTOL = 1e-14
 #: below this angle (rad) SO(3) exp/log use their Taylor series.
 SO3_SMALL_ANGLE = 1e-4
 #: log: when cos(theta) is below this, the axis comes from the symmetric part of R (near pi).
@@ -60,7 +78,7 @@ ROTATION_SYNC_MAX_SWEEPS = 3
 #: Gauss-Newton correction would be of its square: 1e-6 rad).
 ROTATION_SYNC_STEP_TOL = 1e-3
 
-# --- applications: the MSE-vs-cross-entropy experiment (paper Sec. 5.1) ----------------------
+# --- geometry: exact reconstruction (geometry.position_solvers) --------------------------------
 #: exact reconstruction: weight of the paper's Eq. 1 energy added to the exact least-squares
 #: system, relative to the mean diagonals. It only decides the rare position modes the exact system
 #: cannot see (on perfectly symmetric one-rings); its bias on exact features is far below 1e-8.
@@ -72,6 +90,11 @@ EXACT_REFINE_MAX_STEPS = 3
 #: exact reconstruction: no Gauss-Newton step when every entry of T_i(p') - T_i is below this
 #: fraction of the largest |T| entry (exact features on generic meshes need none).
 EXACT_RESIDUAL_TOL = 1e-10
+#: exact reconstruction, refine="auto": Gauss-Newton steps are switched on for a reference mesh when
+#: the linear solve misses a twist of that mesh by more than this fraction of its diagonal (max over
+#: vertices). Measured: 1e-11 to 1e-9 on the horse, cat and cow meshes (off), 1e-6 to 1e-4 on
+#: perfectly regular procedural meshes (on).
+EXACT_SELFTEST_TOL = 1e-8
 
 # --- mesh VAE training defaults (measured: docs/vae.md) --------------------------------------
 #: MeshVAEModel.fit_latent: forward-difference step in latent units (the PCA-started latent
@@ -84,15 +107,24 @@ PCA_INIT_RTOL = 1e-8
 #: largest count as zero when the span of the training meshes is measured.
 PCA_RANK_RTOL = 1e-12
 
-# --- viewing (meshvae_lib.viewing) -----------------------------------------------------------
-#: exact reconstruction, refine="auto": Gauss-Newton steps are switched on for a reference mesh when
-#: the linear solve misses a twist of that mesh by more than this fraction of its diagonal (max over
-#: vertices). Measured: 1e-11 to 1e-9 on the horse, cat and cow meshes (off), 1e-6 to 1e-4 on
-#: perfectly regular procedural meshes (on).
-EXACT_SELFTEST_TOL = 1e-8
+# --- mesh VAE: floors of the encoder's deviation ----------------------------------------------
 #: floor added to the encoder's deviation in the experiments' networks, so that log(sigma^2) in
 #: the KL term stays finite when alpha = 1e6 drives sigma towards 0 (float32 underflow otherwise).
 SIGMA_FLOOR = 1e-6
 #: floor of the deviation head's input: sigma = SIGMA_MAX * sigmoid(max(s, SIGMA_LOGIT_MIN)) keeps
 #: sigma >= 1.9e-13, so log(sigma^2) stays finite when alpha = 1e6 drives sigma towards 0.
 SIGMA_LOGIT_MIN = -30.0
+
+# --- small guards outside the geometry core -------------------------------------------------
+#: render.view_basis: a view direction this close to parallel to the up axis (|cross| below this)
+#: takes another axis to define "right".
+VIEW_PARALLEL_TOL = 1e-9
+#: LatentExplorer.from_encodings: a latent dimension's slider range is at least this wide (a
+#: dimension the encoder never varies would otherwise get a zero-width slider).
+MIN_LATENT_SPREAD = 1e-6
+#: GenerationResult.novelty_ratio: training-set nearest distances below this fraction of the
+#: largest are exact duplicates (shared rest frames) and are left out of the typical spacing.
+DUPLICATE_DISTANCE_RTOL = 1e-9
+#: retrieval.precision_recall_curve: slack when the rank reaching recall rho is rounded up, so that
+#: rho * n_relevant landing exactly on an integer is not pushed to the next rank by round-off.
+RECALL_RANK_SLACK = 1e-9

@@ -10,7 +10,8 @@ import pytest
 import trimesh
 
 from meshvae_lib.geometry.topology import vertex_normals
-from meshvae_lib.viewing.widgets import FramePlayer, InterpolationSlider, LatentExplorer
+from meshvae_lib.viewing.explorer import LatentExplorer
+from meshvae_lib.viewing.widgets import FramePlayer, InterpolationSlider
 
 pytest.importorskip("pythreejs")
 
@@ -202,9 +203,9 @@ def test_interpolation_slider_with_a_custom_path(sphere):
 
 def test_slow_decoder_switches_sliders_to_update_on_release(sphere, monkeypatch):
     V, F = sphere
-    import meshvae_lib.viewing.widgets as widgets
+    import meshvae_lib.viewing.explorer as explorer
 
-    monkeypatch.setattr(widgets, "LIVE_UPDATE_MAX_MS", 5.0)
+    monkeypatch.setattr(explorer, "LIVE_UPDATE_MAX_MS", 5.0)
 
     def slow(z):
         time.sleep(0.02)

@@ -400,7 +400,7 @@ def precision_recall_curve(
         # the first rank whose recall reaches rho is the rank of the m-th relevant sample,
         # m = ceil(rho * n_rel); positions of the relevant samples, in rank order:
         rel_pos = np.argsort(~rel, axis=1, kind="stable")
-        m = np.ceil(rho[None, :] * n_rel[:, None] - 1e-9).astype(np.int64)
+        m = np.ceil(rho[None, :] * n_rel[:, None] - tol.RECALL_RANK_SLACK).astype(np.int64)
         m = np.clip(m, 1, n_rel[:, None])
         first = np.take_along_axis(rel_pos, m - 1, axis=1)
         curve = np.take_along_axis(prec, first, axis=1).mean(axis=0)

@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from meshvae_lib.tolerances import DUPLICATE_DISTANCE_RTOL
+
 __all__ = ["nearest_neighbors", "dataset_feature_rows", "generate", "GenerationResult", "condition_agreement"]
 
 
@@ -94,7 +96,7 @@ class GenerationResult:
         if self.distance is None or self.dataset_nn_distance is None:
             raise ValueError("no nearest neighbours were computed (generate(..., dataset=None))")
         d = self.dataset_nn_distance
-        d = d[d > 1e-9 * max(float(d.max()), 1e-300)]  # exact duplicates (e.g. shared rest frames) say nothing
+        d = d[d > DUPLICATE_DISTANCE_RTOL * max(float(d.max()), 1e-300)]  # exact duplicates (shared rest frames) say nothing
         return self.distance / (np.median(d) if d.size else np.nan)
 
     def rows(self) -> list[dict]:

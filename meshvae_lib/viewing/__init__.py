@@ -3,7 +3,8 @@
 Importing this package imports nothing heavy: the public names are loaded on first use, so
 ``from meshvae_lib.viewing import render_mesh_grid`` pulls in matplotlib only, and pythreejs and
 ipywidgets are imported only by :mod:`~meshvae_lib.viewing.viewer` and
-:mod:`~meshvae_lib.viewing.widgets`.
+:mod:`~meshvae_lib.viewing.widgets`, :mod:`~meshvae_lib.viewing.explorer` and
+:mod:`~meshvae_lib.viewing.latent_pad`.
 
 ==========================  =====================================================================
 module                      public names
@@ -16,7 +17,9 @@ module                      public names
 ``fallback``                ``resolve_mode``, ``ImageView``
 ``gallery``                 ``gallery_indices``, ``mesh_caption``, ``angular_stripes``
 ``viewer``                  ``MeshViewer``
-``widgets``                 ``FramePlayer``, ``LatentExplorer``, ``InterpolationSlider``
+``widgets``                 ``FramePlayer``, ``InterpolationSlider``
+``explorer``                ``LatentExplorer``
+``latent_pad``              ``LatentPad``
 ==========================  =====================================================================
 """
 
@@ -47,7 +50,8 @@ _NAMES = {
     "ImageView": "fallback",
     "MeshViewer": "viewer",
     "FramePlayer": "widgets",
-    "LatentExplorer": "widgets",
+    "LatentExplorer": "explorer",
+    "LatentPad": "latent_pad",
     "InterpolationSlider": "widgets",
 }
 

@@ -17,6 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from meshvae_lib.geometry.topology import face_normals
+from meshvae_lib.tolerances import VIEW_PARALLEL_TOL
 from .buffers import check_vertices, color_buffer
 from .colors import DEFAULT_MESH_COLOR, ColorMapping
 
@@ -64,7 +65,7 @@ def view_basis(view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
         d = np.array([math.cos(elev) * math.sin(azim), -math.cos(elev) * math.cos(azim), math.sin(elev)])
     u = _UP_AXES[up]
     right = np.cross(u, d)
-    if np.linalg.norm(right) < 1e-9:  # looking straight down the up axis
+    if np.linalg.norm(right) < VIEW_PARALLEL_TOL:  # looking straight down the up axis
         right = np.cross(np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, 1.0, 0.0]), d)
     right /= np.linalg.norm(right)
     true_up = np.cross(d, right)
