@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
+from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize, vertex_normals
 from data_synth.skeleton import Skeleton, forward_kinematics
 from data_synth.skinning import dual_quaternion_blend, linear_blend, skinning_weights
 
@@ -216,14 +216,6 @@ def body_template(resolution: int | None = None) -> BodyTemplate:
     return _cached_template(resolution)
 
 
-def _vertex_normals(V, F):
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    vn = np.zeros_like(V)
-    for k in range(3):
-        np.add.at(vn, F[:, k], n)
-    return vn / np.linalg.norm(vn, axis=1, keepdims=True)
-
-
 def _bump(V, center, sigma):
     d2 = np.sum(((V - np.asarray(center)) / np.asarray(sigma)) ** 2, axis=1)
     return np.exp(-0.5 * d2)
@@ -241,7 +233,7 @@ def shape_body(template: BodyTemplate, shape: BodyShape) -> tuple[np.ndarray, np
     g = shape.girth
     female = shape.body_type == "female"
     # 1. offsets along the normals
-    normals = _vertex_normals(V0, F)
+    normals = vertex_normals(V0, F)
     front = np.clip(normals[:, 2], 0.0, None)
     offset = 0.07 * (g - 1.0) * _bump(V0, (0.0, 1.06, 0.08), (0.12, 0.12, 0.1)) * front
     offset += 0.03 * (g - 1.0) * _bump(V0, (0.0, 0.92, -0.1), (0.12, 0.08, 0.08))

@@ -33,6 +33,7 @@ __all__ = [
     "grid_sheet",
     "grid_tube",
     "vertex_adjacency",
+    "vertex_normals",
 ]
 
 
@@ -164,7 +165,22 @@ def _face_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return n
 
 
-def _vertex_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+def vertex_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Area-weighted unit vertex normals of a template or rest mesh.
+
+    The one implementation in ``data_synth``, which does not depend on ``meshvae_lib`` (the
+    library's own is ``meshvae_lib.geometry.topology.vertex_normals``; the two agree to rounding).
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) float64
+    F : (n_faces, 3) int64
+
+    Returns
+    -------
+    N : (n_vertices, 3) float64
+        Unit vectors (a vertex without faces gets the zero vector).
+    """
     fn = _face_normals(V, F)
     vn = np.zeros_like(V)
     for k in range(3):
@@ -190,7 +206,7 @@ def relax(V: np.ndarray, F: np.ndarray, model: ImplicitModel | None, iterations:
     deg = np.asarray(A.sum(axis=1)).ravel()
     V = V.copy()
     for _ in range(iterations):
-        n = _vertex_normals(V, F)
+        n = vertex_normals(V, F)
         move = (A @ V) / deg[:, None] - V
         move -= np.sum(move * n, axis=1, keepdims=True) * n
         V += step * move

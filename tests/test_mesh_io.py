@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 from geometry_fixtures import icosphere, tube
 
-from meshvae_lib.geometry.mesh_io import (
-    MeshCollection, natural_key, read_collection, read_mesh, remove_unreferenced_vertices,
-    validate_mesh, write_collection, write_mesh)
+from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.geometry.collection_io import natural_key, read_collection, write_collection
+from meshvae_lib.geometry.mesh_checks import remove_unreferenced_vertices, validate_mesh
+from meshvae_lib.geometry.mesh_files import read_mesh, write_mesh
 
 
 @pytest.fixture

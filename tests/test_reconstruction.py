@@ -124,7 +124,7 @@ def test_recover_rotations_exact_up_to_global_rotation(bar):
     enc = RIMDEncoder(V0, F, layout="compact")
     log_dR, _ = enc.layout.unpack(enc.transform(V))
     from meshvae_lib.geometry.deformation_gradient import deformation_gradients
-    from meshvae_lib.geometry.rotations import polar_decomposition
+    from meshvae_lib.geometry.polar import polar_decomposition
 
     R_true, _ = polar_decomposition(deformation_gradients(V0, V, F))
     for how in ("global", "bfs"):
@@ -151,7 +151,7 @@ def test_bad_input(bar):
 def test_reflected_one_rings_keep_rotations_and_reconstruct():
     # mirror a curved mesh: T_i has det < 0 at (almost) every vertex
     from meshvae_lib.geometry.deformation_gradient import deformation_gradients
-    from meshvae_lib.geometry.rotations import polar_decomposition
+    from meshvae_lib.geometry.polar import polar_decomposition
 
     V0, F = icosphere(2)
     V0 = bumpy(V0, seed=8)

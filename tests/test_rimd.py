@@ -6,7 +6,9 @@ from geometry_fixtures import bumpy, random_rotation, tube, twist_bend
 
 from meshvae_lib.geometry.deformation_gradient import deformation_gradients
 from meshvae_lib.geometry.rimd import S_ENTRIES, RIMDEncoder, RIMDLayout, rimd_features
-from meshvae_lib.geometry.rotations import polar_decomposition, so3_log
+from meshvae_lib.geometry.rimd_files import load_features, save_features
+from meshvae_lib.geometry.polar import polar_decomposition
+from meshvae_lib.geometry.rotations import so3_log
 from meshvae_lib.geometry.topology import edges
 
 
@@ -111,3 +113,19 @@ def test_bad_input(mesh):
         lay.edge_feature_index(0, len(V0) - 1)
     with pytest.raises(ValueError, match="out of range"):
         lay.vertex_feature_index(len(V0))
+
+
+def test_feature_file_round_trip(mesh, tmp_path):
+    V0, F, V = mesh
+    f = rimd_features(V0, np.stack([V, V0]), F, layout="compact")
+    save_features(tmp_path / "f.npz", f, V0, F, ["a", "b"], {"k": np.array([3, 4])}, layout="compact")
+    d = load_features(tmp_path / "f.npz")
+    np.testing.assert_array_equal(d["features"], f)
+    np.testing.assert_array_equal(d["reference"], V0)
+    assert d["names"] == ["a", "b"] and d["layout"] == "compact" and d["labels"]["k"].tolist() == [3, 4]
+    with pytest.raises(ValueError, match="layout of this mesh has K"):
+        save_features(tmp_path / "g.npz", f, V0, F)  # compact rows, paper layout
+    with pytest.raises(ValueError, match=r"features must have shape \(n_meshes, k\)"):
+        save_features(tmp_path / "g.npz", f[0], V0, F, layout="compact")
+    with pytest.raises(ValueError, match="must end in .npz"):
+        save_features(tmp_path / "g.txt", f, V0, F, layout="compact")

@@ -220,3 +220,15 @@ def test_flag_pole_is_scenery_along_the_attached_edge(collections):
     n = np.cross(Vp[Fp[:, 1]] - Vp[Fp[:, 0]], Vp[Fp[:, 2]] - Vp[Fp[:, 0]])
     out = Vp[Fp].mean(axis=1)[:, [0, 2]] - axis
     assert np.all(np.einsum("ij,ij->i", n[:, [0, 2]], out) > 0)
+
+
+def test_data_synth_normals_agree_with_the_library(collections):
+    """data_synth keeps its own vertex normals (it does not import meshvae_lib); they must be the
+    library's to rounding."""
+    from data_synth.meshing import vertex_normals
+    from meshvae_lib.geometry.topology import vertex_normals as library_normals
+
+    for name in ("dyna", "hand", "flag"):
+        col = collections[name]
+        V = col.vertices[0]
+        np.testing.assert_allclose(vertex_normals(V, col.faces), library_normals(V, col.faces), atol=1e-12)

@@ -112,3 +112,14 @@ def test_bad_input_errors():
         T.vertex_normals(np.zeros((3, 2)), [[0, 1, 2]])
     with pytest.raises(ValueError, match="3 vertices"):
         T.face_normals(np.zeros((3, 3)), [[0, 1, 3]])
+
+
+def test_edge_lengths_and_vertex_face_incidence():
+    L = T.edge_lengths(SQUARE_V, SQUARE_F)  # edges (0,1), (0,2), (0,3), (1,2), (2,3)
+    np.testing.assert_allclose(L, [1, np.sqrt(2), 1, 1, 1], atol=1e-15)
+    Lb = T.edge_lengths(np.stack([SQUARE_V, 2 * SQUARE_V]), SQUARE_F)
+    assert Lb.shape == (2, 5) and np.allclose(Lb[1], 2 * L)
+    inc = T.vertex_face_incidence(SQUARE_F, 5).toarray()
+    np.testing.assert_array_equal(inc, [[1, 1], [1, 0], [1, 1], [0, 1], [0, 0]])
+    with pytest.raises(ValueError, match="4 vertices"):
+        T.edge_lengths(SQUARE_V, [[0, 1, 4]])

@@ -8,16 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvae_lib.validation import check_vertices
+
 __all__ = ["rigid_transform", "rigid_align", "bounding_box_diagonal"]
-
-
-def _check_points(X, name: str) -> np.ndarray:
-    X = np.asarray(X, dtype=np.float64)
-    if X.ndim not in (2, 3) or X.shape[-1] != 3:
-        raise ValueError(
-            f"{name} must have shape (n_vertices, 3) or (n_meshes, n_vertices, 3), got {X.shape}"
-        )
-    return X
 
 
 def rigid_transform(source, target) -> tuple[np.ndarray, np.ndarray]:
@@ -38,8 +31,8 @@ def rigid_transform(source, target) -> tuple[np.ndarray, np.ndarray]:
         Rotation, applied as ``source @ R.T``.
     t : (3,) or (n_meshes, 3) float64
     """
-    P = _check_points(source, "source")
-    Q = _check_points(target, "target")
+    P = check_vertices(source, "source")
+    Q = check_vertices(target, "target")
     if P.shape[-2] != Q.shape[-2]:
         raise ValueError(
             f"source and target must have the same number of vertices, got {P.shape} and {Q.shape}"
@@ -86,6 +79,6 @@ def bounding_box_diagonal(V) -> np.ndarray | float:
     -------
     d : float, or (n_meshes,) float64
     """
-    V = _check_points(V, "V")
+    V = check_vertices(V, "V")
     d = np.linalg.norm(V.max(axis=-2) - V.min(axis=-2), axis=-1)
     return float(d) if V.ndim == 2 else d

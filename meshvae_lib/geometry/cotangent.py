@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.geometry.topology import _check_positions, face_edge_indices, edges
+from meshvae_lib.geometry.topology import face_edge_indices, edges
+from meshvae_lib.validation import check_mesh
 
 __all__ = ["corner_cotangents", "cotangent_weights"]
 
@@ -42,9 +43,7 @@ def corner_cotangents(V, F) -> np.ndarray:
         ``cot[f, k]`` is the cotangent of the angle of face ``f`` at corner ``F[f, k]``; ``inf`` or
         NaN for a zero-area face.
     """
-    V, F = _check_positions(V, F)
-    if V.ndim != 2:
-        raise ValueError(f"V must have shape (n_vertices, 3), got {V.shape}")
+    V, F = check_mesh(V, F, batch=False, name="V")
     P = V[F]  # (m, 3, 3)
     a = np.roll(P, -1, axis=1) - P  # corner k -> k+1
     b = np.roll(P, -2, axis=1) - P  # corner k -> k+2
@@ -72,7 +71,7 @@ def cotangent_weights(V, F, clamp: bool = True) -> np.ndarray:
     c : (n_edges,) float64
         Aligned with :func:`meshvae_lib.geometry.topology.edges`. Boundary edges have one term only.
     """
-    V, F = _check_positions(V, F)
+    V, F = check_mesh(V, F, batch=False, name="V")
     cot = corner_cotangents(V, F)
     FE = face_edge_indices(F)  # edge opposite each corner
     c = np.bincount(FE.reshape(-1), weights=cot.reshape(-1), minlength=len(edges(F)))

@@ -32,9 +32,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from meshvae_lib import defaults as hp
+from meshvae_lib import tolerances as tol
 from meshvae_lib.geometry.cotangent import cotangent_weights
 from meshvae_lib.geometry.rotations import from_soa
-from meshvae_lib.geometry.topology import _check_positions, directed_edges, edge_index, edges, vertex_normal_sums
+from meshvae_lib.geometry.topology import (
+    directed_edges, edge_index, edges, vertex_face_incidence, vertex_normal_sums)
+from meshvae_lib.validation import check_mesh, check_vertices
 
 __all__ = ["DeformationGradientOperator", "deformation_gradients"]
 
@@ -80,9 +83,7 @@ class DeformationGradientOperator:
     """
 
     def __init__(self, V0, F, normal_term: bool = True, clamp: bool = True):
-        V0, F = _check_positions(V0, F)
-        if V0.ndim != 2:
-            raise ValueError(f"V0 must have shape (n_vertices, 3), got {V0.shape}")
+        V0, F = check_mesh(V0, F, batch=False, name="V0")
         n = V0.shape[0]
         self.n_vertices = n
         self.faces = F
@@ -118,7 +119,7 @@ class DeformationGradientOperator:
         self.A = A
         det = np.linalg.det(A)
         scale = np.einsum("nij,nij->n", A, A) ** 1.5
-        bad = ~(np.abs(det) > 1e-14 * scale)
+        bad = ~(np.abs(det) > tol.ONE_RING_SINGULAR_RTOL * scale)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise ValueError(
@@ -138,16 +139,19 @@ class DeformationGradientOperator:
         self.K = sp.csr_matrix((vals, (rows, cols)), shape=(3 * n, n))
         self.K.sum_duplicates()
 
-    def _check(self, V) -> np.ndarray:
-        V = np.asarray(V, dtype=np.float64)
-        n = self.n_vertices
-        if V.ndim not in (2, 3) or V.shape[-2:] != (n, 3):
-            raise ValueError(
-                f"deformed vertices must have shape ({n}, 3) or (n_meshes, {n}, 3), got {V.shape}"
-            )
-        if not np.all(np.isfinite(V)):
-            raise ValueError("deformed vertices hold NaN or infinite coordinates")
-        return V
+    def check_deformed(self, V) -> np.ndarray:
+        """Deformed positions this operator accepts.
+
+        Parameters
+        ----------
+        V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+            Finite, with this operator's number of vertices.
+
+        Returns
+        -------
+        V : float64 array of the input's shape
+        """
+        return check_vertices(V, "deformed vertices", n_vertices=self.n_vertices, finite=True)
 
     def apply_soa(self, V) -> np.ndarray:
         """Deformation gradients in structure-of-arrays form.
@@ -178,10 +182,7 @@ class DeformationGradientOperator:
     def _normal_sums_batch(self, V: np.ndarray) -> np.ndarray:
         """:func:`vertex_normal_sums` of ``(N, n, 3)`` with the incidence matrix built once."""
         if not hasattr(self, "_incidence"):
-            m = len(self.faces)
-            self._incidence = sp.csr_matrix(
-                (np.ones(3 * m), (self.faces.reshape(-1), np.repeat(np.arange(m), 3))),
-                shape=(self.n_vertices, m))
+            self._incidence = vertex_face_incidence(self.faces, self.n_vertices)
         F = self.faces
         p0 = V[:, F[:, 0], :]
         a = V[:, F[:, 1], :] - p0
@@ -212,7 +213,7 @@ class DeformationGradientOperator:
         """
         acc = self._normal_sums_batch(V)
         na = np.sqrt(np.einsum("...k,...k->...", acc, acc))[..., None]
-        scale = self.normal_length / np.sqrt(np.maximum(na, 1e-300) * self._normal_sum_norms[:, None])
+        scale = self.normal_length / np.sqrt(np.maximum(na, tol.DIVISION_FLOOR) * self._normal_sum_norms[:, None])
         return acc * scale
 
     def __call__(self, V) -> np.ndarray:
@@ -226,7 +227,7 @@ class DeformationGradientOperator:
         -------
         T : (n_vertices, 3, 3) or (n_meshes, n_vertices, 3, 3) float64
         """
-        V = self._check(V)
+        V = self.check_deformed(V)
         single = V.ndim == 2
         Vb = V[None] if single else V
         T = from_soa(self.apply_soa(Vb)).reshape(Vb.shape[0], self.n_vertices, 3, 3)

@@ -32,19 +32,17 @@ import logging
 
 import numpy as np
 
+from meshvae_lib.defaults import LAYOUTS
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
-from meshvae_lib.geometry.rotations import _polar_rs_soa, _quat_from_soa, _relative_log_quat
-from meshvae_lib.geometry.topology import _check_faces, directed_edges, edge_index, edges
+from meshvae_lib.geometry.polar import polar_rs_soa
+from meshvae_lib.geometry.rotations import quat_from_soa, relative_log_quat
+from meshvae_lib.geometry.topology import directed_edges, edge_index, edges
+from meshvae_lib.validation import check_choice, check_faces, check_rows
 
-__all__ = [
-    "LAYOUTS", "S_ENTRIES", "RIMDLayout", "RIMDEncoder", "rimd_features", "save_features",
-    "load_features",
-]
+__all__ = ["S_ENTRIES", "RIMDLayout", "RIMDEncoder", "rimd_features"]
 
 logger = logging.getLogger(__name__)
 
-#: the two feature layouts.
-from meshvae_lib.defaults import LAYOUTS  # noqa: E402  (re-exported)
 #: the 6 stored entries (row, column) of each symmetric S_i, in feature order.
 S_ENTRIES = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 _S_FLAT = np.array([3 * a + b for a, b in S_ENTRIES])
@@ -75,12 +73,9 @@ class RIMDLayout:
     """
 
     def __init__(self, F, n_vertices: int, layout: str = "paper"):
-        if layout not in LAYOUTS:
-            raise ValueError(f"layout must be one of {LAYOUTS}, got {layout!r}")
-        F = _check_faces(F)
+        check_choice(layout, LAYOUTS, "layout")
         n_vertices = int(n_vertices)
-        if F.size and F.max() >= n_vertices:
-            raise ValueError(f"faces reference vertex {F.max()} but n_vertices={n_vertices}")
+        F = check_faces(F, n_vertices=n_vertices)
         self.layout = layout
         self.n_vertices = n_vertices
         self.edges = edges(F)
@@ -153,14 +148,18 @@ class RIMDLayout:
             raise ValueError(f"vertex {i} out of range [0, {self.n_vertices - 1}]")
         return self.scaling_slice.start + 6 * i + np.arange(6)
 
-    def _check_features(self, features) -> np.ndarray:
-        f = np.asarray(features, dtype=np.float64)
-        if f.ndim not in (1, 2) or f.shape[-1] != self.K:
-            raise ValueError(
-                f"features must have shape ({self.K},) or (n_meshes, {self.K}) for this "
-                f"{self.layout!r} layout, got {f.shape}"
-            )
-        return f
+    def check_features(self, features) -> np.ndarray:
+        """Feature vector(s) in this layout.
+
+        Parameters
+        ----------
+        features : (K,) or (n_meshes, K) float
+
+        Returns
+        -------
+        f : float64 array of the input's shape
+        """
+        return check_rows(features, "features", self.K, what=f"for this {self.layout!r} layout")
 
     def rotation_part(self, features, i: int, j: int) -> np.ndarray:
         """``log dR_ij`` (rotation vector) from feature vector(s), for any edge direction.
@@ -173,7 +172,7 @@ class RIMDLayout:
         -------
         w : (3,) or (n_meshes, 3) float64
         """
-        f = self._check_features(features)
+        f = self.check_features(features)
         if self.layout == "compact" and int(i) > int(j):
             return -f[..., self.edge_feature_index(j, i)]
         return f[..., self.edge_feature_index(i, j)]
@@ -185,7 +184,7 @@ class RIMDLayout:
         -------
         S : (3, 3) or (n_meshes, 3, 3) float64
         """
-        f = self._check_features(features)
+        f = self.check_features(features)
         s6 = f[..., self.vertex_feature_index(i)]
         return _sym_from_6(s6)
 
@@ -226,7 +225,7 @@ class RIMDLayout:
         log_dR : (n_meshes, n_edges, 3) float64
         S : (n_meshes, n_vertices, 3, 3) float64
         """
-        f = self._check_features(features)
+        f = self.check_features(features)
         f = f.reshape(-1, self.K)
         N = f.shape[0]
         rot = f[:, self.rotation_slice].reshape(N, self.n_rotation_edges, 3)
@@ -289,7 +288,7 @@ class RIMDEncoder:
         -------
         f : (K,) or (n_meshes, K) float64
         """
-        V = self.operator._check(V)
+        V = self.operator.check_deformed(V)
         single = V.ndim == 2
         Vb = V[None] if single else V
         N = Vb.shape[0]
@@ -309,15 +308,15 @@ class RIMDEncoder:
     def _transform_batch(self, V: np.ndarray) -> np.ndarray:
         N, n = V.shape[0], self.operator.n_vertices
         t = self.operator.apply_soa(V)  # (9, N n)
-        r, s = _polar_rs_soa(t)
+        r, s = polar_rs_soa(t)
         E = self.layout.edges
         offs = (np.arange(N) * n)[:, None]
         ii = (offs + E[:, 0]).reshape(-1)
         jj = (offs + E[:, 1]).reshape(-1)
         # log(R_i^T R_j) through unit quaternions: fewer operations than forming R_i^T R_j
         # (checked against so3_log in the tests)
-        q = _quat_from_soa(r)  # (4, N n)
-        w = _relative_log_quat(q[:, ii], q[:, jj])  # (3, N E)
+        q = quat_from_soa(r)  # (4, N n)
+        w = relative_log_quat(q[:, ii], q[:, jj])  # (3, N E)
         log_dR = np.ascontiguousarray(w.T).reshape(N, len(E), 3)
         S6 = np.ascontiguousarray(s[_S_FLAT].T).reshape(N, n, 6)
         return self.layout.pack(log_dR, S6)
@@ -344,104 +343,3 @@ def rimd_features(V0, V, F, layout: str = "paper") -> np.ndarray:
     f : (K,) or (n_meshes, K) float64
     """
     return RIMDEncoder(V0, F, layout=layout).transform(V)
-
-
-# ---------------------------------------------------------------------------------------------
-# feature files (written by ``meshvae features``, read by ``meshvae reconstruct``)
-
-#: arrays every feature file holds.
-FEATURE_FILE_KEYS = ("features", "reference", "faces", "names", "layout")
-
-
-def save_features(path, features, reference, faces, names=None, labels=None,
-                  layout: str = "paper") -> None:
-    """Write a feature file (``.npz``, uncompressed, float64 kept).
-
-    Parameters
-    ----------
-    path : str or Path
-        Ends in ``.npz``.
-    features : (n_meshes, K) float64
-    reference : (n_vertices, 3) float64
-        The mesh the features are relative to.
-    faces : (n_faces, 3) int64
-    names : list of str, optional
-    labels : dict str -> (n_meshes,) array, optional
-        Stored as ``label_<column>``.
-    layout : {"paper", "compact"}
-    """
-    from pathlib import Path
-
-    path = Path(path)
-    if path.suffix.lower() != ".npz":
-        raise ValueError(f"a feature file must end in .npz, got {path}")
-    if not path.parent.is_dir():
-        raise FileNotFoundError(f"folder does not exist: {path.parent}")
-    features = np.asarray(features, dtype=np.float64)
-    if features.ndim != 2:
-        raise ValueError(f"features must have shape (n_meshes, K), got {features.shape}")
-    lay = RIMDLayout(faces, len(reference), layout)
-    if features.shape[1] != lay.K:
-        raise ValueError(f"features have {features.shape[1]} columns; the {layout!r} layout of "
-                         f"this mesh has K = {lay.K}")
-    n = features.shape[0]
-    names = [f"{k:04d}" for k in range(n)] if names is None else [str(s) for s in names]
-    arrays = {
-        "features": features,
-        "reference": np.asarray(reference, dtype=np.float64),
-        "faces": np.asarray(faces, dtype=np.int64),
-        "names": np.array(names),
-        "layout": np.array(layout),
-    }
-    for key, val in (labels or {}).items():
-        arrays[f"label_{key}"] = np.asarray(val)
-    np.savez(path, **arrays)
-
-
-def load_features(path) -> dict:
-    """Read a feature file written by :func:`save_features` (or ``meshvae features``).
-
-    Returns
-    -------
-    dict with ``features (N, K) float64``, ``reference (n, 3) float64``, ``faces (F, 3) int64``,
-    ``names`` (list of str), ``labels`` (dict), ``layout`` (str).
-
-    Raises
-    ------
-    FileNotFoundError, ValueError
-        Missing file, missing arrays, or a feature length that does not match the layout.
-    """
-    from pathlib import Path
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no such feature file: {path}")
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:
-        raise ValueError(f"{path.name}: cannot be read as .npz ({exc})") from exc
-    with data:
-        missing = [k for k in ("features", "reference", "faces") if k not in data.files]
-        if missing:
-            raise ValueError(f"{path.name}: not a feature file, it lacks {missing} "
-                             f"(found {data.files}); make one with `meshvae features`")
-        out = {
-            "features": np.asarray(data["features"], dtype=np.float64),
-            "reference": np.asarray(data["reference"], dtype=np.float64),
-            "faces": np.asarray(data["faces"], dtype=np.int64),
-            "layout": str(data["layout"]) if "layout" in data.files else "paper",
-            "labels": {k[len("label_"):]: np.asarray(data[k]) for k in data.files
-                       if k.startswith("label_")},
-        }
-        f = out["features"]
-        if f.ndim == 1:
-            f = out["features"] = f[None]
-        out["names"] = ([str(s) for s in data["names"]] if "names" in data.files
-                        else [f"{k:04d}" for k in range(len(f))])
-    lay = RIMDLayout(out["faces"], len(out["reference"]), out["layout"])
-    if f.ndim != 2 or f.shape[1] != lay.K:
-        raise ValueError(f"{path.name}: features have shape {f.shape}, but the {out['layout']!r} "
-                         f"layout of its reference mesh needs K = {lay.K}")
-    if len(out["names"]) != len(f):
-        raise ValueError(f"{path.name}: {len(out['names'])} names for {len(f)} feature rows")
-    return out

@@ -1,21 +1,22 @@
-"""Rotations: polar decomposition T = R S, and the SO(3) logarithm and exponential.
+"""Rotations: the SO(3) logarithm and exponential, and the batched 3x3 kernels they run on.
 
-Everything is vectorised over leading axes ``(..., 3, 3)`` and written in closed form (no SVD in
-the hot path):
+Everything is vectorised over leading axes and written in closed form:
 
-- :func:`polar_decomposition` uses the scaled Newton iteration ``X <- (g X + X^{-T} / g) / 2``
-  (Higham 1986) with the 3x3 inverse-transpose from cross products; it converges quadratically to
-  the orthogonal polar factor. Where ``det T < 0`` that factor is a reflection; as in the reference
-  implementation the reflection is moved into ``S`` by flipping the eigenvector of ``S`` with the
-  smallest eigenvalue, so ``R`` is always a rotation (``det R = +1``) and ``S`` stays symmetric.
-  Singular or badly conditioned ``T`` fall back to ``numpy.linalg.svd``.
 - :func:`so3_log` uses ``theta = atan2(|v| / 2, (tr R - 1) / 2)`` with ``v`` the axial vector of
   ``R - R^T``, a series for small angles, and the symmetric part ``R + R^T`` for the axis near
   ``theta = pi`` (where ``v`` vanishes). Accurate to ~1e-15 everywhere, no NaN at ``pi``.
 - :func:`so3_exp` is Rodrigues' formula with series for small angles.
+- The polar decomposition ``T = R S`` lives in :mod:`meshvae_lib.geometry.polar`.
 
 Convention: ``so3_exp(w)`` rotates by ``|w|`` radians about ``w / |w|`` (right-hand rule), and
 ``hat(w) @ x = w x x`` (cross product).
+
+The hot paths of the feature extraction and the reconstruction work on the *structure-of-arrays*
+layout: ``m`` matrices as one ``(9, m)`` array of row-major entries (:func:`to_soa`,
+:func:`from_soa`, :func:`matmul_soa`), rotation vectors as ``(3, m)`` (:func:`exp_soa`,
+:func:`log_soa`) and unit quaternions ``(w, x, y, z)`` as ``(4, m)`` (:func:`quat_from_soa`,
+:func:`quat_exp_soa`, :func:`quat_mul_soa`, :func:`relative_log_quat`); component-wise numpy on
+long rows is several times faster than ``np.matmul`` or ``np.cross`` on ``(m, 3, 3)``.
 """
 
 from __future__ import annotations
@@ -23,23 +24,24 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib import tolerances as tol
+from meshvae_lib.validation import check_matrices, check_vectors
 
 __all__ = [
     "hat",
     "vee",
-    "polar_decomposition",
     "so3_log",
     "so3_exp",
     "rotation_angle",
-    "project_to_so3",
+    "to_soa",
+    "from_soa",
+    "matmul_soa",
+    "exp_soa",
+    "log_soa",
+    "quat_from_soa",
+    "quat_exp_soa",
+    "quat_mul_soa",
+    "relative_log_quat",
 ]
-
-
-def _check_mats(T, name: str) -> np.ndarray:
-    T = np.asarray(T, dtype=np.float64)
-    if T.ndim < 2 or T.shape[-2:] != (3, 3):
-        raise ValueError(f"{name} must have shape (..., 3, 3), got {T.shape}")
-    return T
 
 
 def hat(w) -> np.ndarray:
@@ -53,9 +55,7 @@ def hat(w) -> np.ndarray:
     -------
     W : (..., 3, 3) float64
     """
-    w = np.asarray(w, dtype=np.float64)
-    if w.shape[-1:] != (3,):
-        raise ValueError(f"w must have shape (..., 3), got {w.shape}")
+    w = check_vectors(w, "w")
     W = np.zeros(w.shape[:-1] + (3, 3))
     W[..., 0, 1], W[..., 0, 2] = -w[..., 2], w[..., 1]
     W[..., 1, 0], W[..., 1, 2] = w[..., 2], -w[..., 0]
@@ -74,49 +74,30 @@ def vee(W) -> np.ndarray:
     -------
     w : (..., 3) float64
     """
-    W = _check_mats(W, "W")
+    W = check_matrices(W, "W")
     return 0.5 * np.stack(
         [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]],
         axis=-1,
     )
 
 
-def _cofactor_soa(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cofactor matrix and determinant, structure-of-arrays: ``x`` is ``(9, m)``, row-major entries.
-
-    ``X^{-T} = cof / det``. Written component-wise because ``np.cross`` on ``(m, 3)`` arrays is an
-    order of magnitude slower.
-    """
-    a, b, c, d, e, f, g, h, i = x
-    cof = np.empty_like(x)
-    cof[0] = e * i - f * h
-    cof[1] = f * g - d * i
-    cof[2] = d * h - e * g
-    cof[3] = c * h - b * i
-    cof[4] = a * i - c * g
-    cof[5] = b * g - a * h
-    cof[6] = b * f - c * e
-    cof[7] = c * d - a * f
-    cof[8] = a * e - b * d
-    det = a * cof[0] + b * cof[1] + c * cof[2]
-    return cof, det
-
-
 def to_soa(M: np.ndarray) -> np.ndarray:
-    """``(m, 3, 3)`` matrices to structure-of-arrays ``(9, m)`` (row-major entries)."""
+    """``(..., 3, 3)`` matrices (``m`` of them) to structure-of-arrays ``(9, m)`` float64 (row-major
+    entries)."""
     return np.ascontiguousarray(M.reshape(-1, 9).T)
 
 
 def from_soa(x: np.ndarray) -> np.ndarray:
-    """Structure-of-arrays ``(9, m)`` back to ``(m, 3, 3)``."""
+    """Structure-of-arrays ``(9, m)`` back to ``(m, 3, 3)`` float64 (C-contiguous)."""
     return np.ascontiguousarray(x.T).reshape(-1, 3, 3)
 
 
 def matmul_soa(a: np.ndarray, b: np.ndarray, transpose_a: bool = False,
                transpose_b: bool = False) -> np.ndarray:
-    """Batched 3x3 products on ``(9, m)`` arrays: ``a @ b`` (optionally transposed factors).
+    """Batched 3x3 products on structure-of-arrays: ``a @ b`` (optionally transposed factors).
 
-    Faster than ``np.matmul`` on ``(m, 3, 3)`` for large ``m``.
+    ``a`` and ``b`` are ``(9, m)`` (or one of them ``(9, 1)``, broadcast); returns ``(9, m)``
+    float64. Faster than ``np.matmul`` on ``(m, 3, 3)`` for large ``m``.
     """
     def at(i, k):
         return a[3 * k + i] if transpose_a else a[3 * i + k]
@@ -138,102 +119,6 @@ def matmul_soa(a: np.ndarray, b: np.ndarray, transpose_a: bool = False,
     return out
 
 
-def _polar_soa(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Orthogonal polar factor by scaled Newton on ``(9, m)``.
-
-    Returns ``(u, det_t, ok, n_iter)``: ``u`` (9, m) orthogonal factor, ``det T``, a mask of the
-    matrices Newton handled (non-singular, converged) and the iterations used.
-    """
-    x = t.copy()
-    m = x.shape[1]
-    cof, det_t = _cofactor_soa(x)
-    nx = np.sqrt(np.einsum("km,km->m", x, x))
-    ok = np.abs(det_t) > tol.POLAR_SINGULAR_RTOL * nx**3
-    det = np.where(ok, det_t, 1.0)
-    scaled = True
-    it = 0
-    for it in range(1, tol.POLAR_MAX_ITERATIONS + 1):
-        if scaled:
-            nc = np.sqrt(np.einsum("km,km->m", cof, cof))
-            g = np.sqrt(nc / (np.abs(det) * np.where(nx > 0, nx, 1.0)))
-            g = np.where(ok, g, 1.0)
-            x *= 0.5 * g
-            cof *= 0.5 / (det * g)
-            x += cof
-            if it >= tol.POLAR_SCALED_ITERATIONS or np.max(np.abs(g - 1.0)) < 1e-3:
-                scaled = False
-        else:
-            x_old = x
-            x = 0.5 * x_old + cof * (0.5 / det)
-            if m == 0 or np.max(np.abs(x - x_old)) < tol.POLAR_CONVERGENCE:
-                break
-        cof, det = _cofactor_soa(x)
-        det = np.where(ok, det, 1.0)
-        if scaled:
-            nx = np.sqrt(np.einsum("km,km->m", x, x))
-    return x, det_t, ok, it
-
-
-def polar_decomposition(T) -> tuple[np.ndarray, np.ndarray]:
-    """Polar decomposition ``T = R S`` with ``R`` a rotation and ``S`` symmetric.
-
-    For ``det T > 0``, ``S`` is the symmetric positive definite stretch ``sqrt(T^T T)``. For
-    ``det T < 0`` the orthogonal factor would be a reflection; instead ``R`` stays in SO(3) and ``S``
-    takes the reflection (its eigenvalue of smallest magnitude becomes negative), as in the RIMD
-    reference implementation. Used for ``T_i = R_i S_i`` (paper Sec. 3).
-
-    Parameters
-    ----------
-    T : (..., 3, 3) float
-
-    Returns
-    -------
-    R : (..., 3, 3) float64
-        Rotations, ``det R = +1``.
-    S : (..., 3, 3) float64
-        Symmetric, ``R @ S == T``.
-    """
-    T = _check_mats(T, "T")
-    if not np.all(np.isfinite(T)):
-        raise ValueError("T holds NaN or infinite entries")
-    shape = T.shape[:-2]
-    r, s = _polar_rs_soa(to_soa(T))
-    return from_soa(r).reshape(shape + (3, 3)), from_soa(s).reshape(shape + (3, 3))
-
-
-def _polar_rs_soa(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Polar decomposition on ``(9, m)``: rotation ``r`` and symmetric ``s``, both ``(9, m)``."""
-    u, det_t, ok, _ = _polar_soa(t)
-    s = matmul_soa(u, t, transpose_a=True)
-    # symmetrise
-    for i, j in ((0, 1), (0, 2), (1, 2)):
-        v = 0.5 * (s[3 * i + j] + s[3 * j + i])
-        s[3 * i + j] = v
-        s[3 * j + i] = v
-    bad = ~ok
-    if bad.any():
-        idx = np.flatnonzero(bad)
-        Us, sig, Vt = np.linalg.svd(from_soa(t[:, idx]))
-        u[:, idx] = to_soa(Us @ Vt)
-        s[:, idx] = to_soa((np.swapaxes(Vt, -1, -2) * sig[:, None, :]) @ Vt)
-        det_t = det_t.copy()
-        det_t[idx] = np.linalg.det(Us @ Vt)
-    neg = det_t < 0
-    if neg.any():
-        # the orthogonal factor is a reflection: flip the eigenvector of S with the smallest
-        # eigenvalue, moving the reflection into S (R = U F, S = F S, F = I - 2 v v^T).
-        idx = np.flatnonzero(neg)
-        Sn = from_soa(s[:, idx])
-        _, vecs = np.linalg.eigh(Sn)
-        v = vecs[:, :, 0]
-        Fm = np.eye(3) - 2.0 * v[:, :, None] * v[:, None, :]
-        Rn = from_soa(u[:, idx]) @ Fm
-        Sn = Fm @ Sn
-        u[:, idx] = to_soa(Rn)
-        s[:, idx] = to_soa(0.5 * (Sn + np.swapaxes(Sn, -1, -2)))
-    return u, s
-
-
 def rotation_angle(R) -> np.ndarray:
     """Rotation angle in ``[0, pi]``, by ``atan2`` (accurate near 0 and near pi).
 
@@ -246,7 +131,7 @@ def rotation_angle(R) -> np.ndarray:
     -------
     theta : (...) float64
     """
-    R = _check_mats(R, "R")
+    R = check_matrices(R, "R")
     v = 2.0 * vee(R)  # 2 sin(theta) u
     s = 0.5 * np.linalg.norm(v, axis=-1)
     c = 0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0)
@@ -269,13 +154,14 @@ def so3_log(R) -> np.ndarray:
         ``so3_exp(w) == R``. At exactly ``pi`` the axis sign is arbitrary (``w`` and ``-w`` give the
         same rotation); near ``pi`` the sign follows the antisymmetric part of ``R``.
     """
-    R = _check_mats(R, "R")
+    R = check_matrices(R, "R")
     shape = R.shape[:-2]
-    return np.ascontiguousarray(_log_soa(to_soa(R)).T).reshape(shape + (3,))
+    return np.ascontiguousarray(log_soa(to_soa(R)).T).reshape(shape + (3,))
 
 
-def _log_soa(r: np.ndarray) -> np.ndarray:
-    """:func:`so3_log` on structure-of-arrays: ``r`` (9, m) -> ``w`` (3, m)."""
+def log_soa(r: np.ndarray) -> np.ndarray:
+    """:func:`so3_log` on structure-of-arrays: rotations ``r (9, m)`` -> rotation vectors
+    ``w (3, m)`` float64."""
     v = np.stack([r[7] - r[5], r[2] - r[6], r[3] - r[1]])  # 2 sin(theta) u
     nv = np.sqrt(np.einsum("km,km->m", v, v))
     c = 0.5 * (r[0] + r[4] + r[8] - 1.0)
@@ -297,7 +183,8 @@ def _log_soa(r: np.ndarray) -> np.ndarray:
         d = np.diagonal(B, axis1=-2, axis2=-1)
         k = np.argmax(d, axis=-1)
         col = np.take_along_axis(B, k[:, None, None], axis=-1)[..., 0]  # (m, 3) = u_k u
-        u = col / np.sqrt(np.maximum(np.take_along_axis(d, k[:, None], axis=-1), 1e-300))
+        dk = np.take_along_axis(d, k[:, None], axis=-1)
+        u = col / np.sqrt(np.maximum(dk, tol.DIVISION_FLOOR))
         u /= np.linalg.norm(u, axis=-1, keepdims=True)
         sign = np.sign(np.einsum("mk,km->m", u, v[:, idx]))
         sign = np.where(sign == 0, 1.0, sign)
@@ -318,15 +205,14 @@ def so3_exp(w) -> np.ndarray:
     R : (..., 3, 3) float64
         Rotation matrices.
     """
-    w = np.asarray(w, dtype=np.float64)
-    if w.shape[-1:] != (3,):
-        raise ValueError(f"w must have shape (..., 3), got {w.shape}")
+    w = check_vectors(w, "w")
     shape = w.shape[:-1]
-    return from_soa(_exp_soa(np.ascontiguousarray(w.reshape(-1, 3).T))).reshape(shape + (3, 3))
+    return from_soa(exp_soa(np.ascontiguousarray(w.reshape(-1, 3).T))).reshape(shape + (3, 3))
 
 
-def _exp_soa(w: np.ndarray) -> np.ndarray:
-    """:func:`so3_exp` on structure-of-arrays: ``w`` (3, m) -> ``r`` (9, m)."""
+def exp_soa(w: np.ndarray) -> np.ndarray:
+    """:func:`so3_exp` on structure-of-arrays: rotation vectors ``w (3, m)`` -> rotations
+    ``r (9, m)`` float64."""
     x, y, z = w
     th2 = x * x + y * y + z * z
     th = np.sqrt(th2)
@@ -352,21 +238,7 @@ def _exp_soa(w: np.ndarray) -> np.ndarray:
     return r
 
 
-def project_to_so3(M) -> np.ndarray:
-    """Closest rotation to each matrix (Frobenius norm): the rotation part of its polar factor.
-
-    Parameters
-    ----------
-    M : (..., 3, 3) float
-
-    Returns
-    -------
-    R : (..., 3, 3) float64
-    """
-    return polar_decomposition(M)[0]
-
-
-def _quat_from_soa(r: np.ndarray) -> np.ndarray:
+def quat_from_soa(r: np.ndarray) -> np.ndarray:
     """Unit quaternions ``(4, m)`` (w, x, y, z) of rotations ``(9, m)``, Shepperd's method.
 
     Each column uses the largest of ``(w, x, y, z)`` as pivot, so the result is accurate to
@@ -399,7 +271,7 @@ def _quat_from_soa(r: np.ndarray) -> np.ndarray:
     return q
 
 
-def _relative_log_quat(qi: np.ndarray, qj: np.ndarray) -> np.ndarray:
+def relative_log_quat(qi: np.ndarray, qj: np.ndarray) -> np.ndarray:
     """``log(R_i^T R_j)`` as rotation vectors ``(3, m)`` from unit quaternions ``(4, m)``.
 
     ``conj(q_i) q_j`` is the quaternion of ``R_i^T R_j``; its log is
@@ -415,7 +287,29 @@ def _relative_log_quat(qi: np.ndarray, qj: np.ndarray) -> np.ndarray:
     nv = np.sqrt(x * x + y * y + z * z)
     sign = np.where(w < 0, -1.0, 1.0)
     theta = 2.0 * np.arctan2(nv, np.abs(w))
-    small = nv < 1e-300
+    small = nv < tol.DIVISION_FLOOR
     # theta / |v| -> 2 / |w| as |v| -> 0 (series: 2 (1 - |v|^2 / (3 w^2)) / |w| is exact enough)
     factor = np.where(small, 2.0, theta / np.where(small, 1.0, nv)) * sign
     return np.stack([factor * x, factor * y, factor * z])
+
+
+def quat_exp_soa(w: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``(4, m)`` float64 of rotation vectors ``(3, m)``:
+    ``(cos(t/2), sin(t/2) w / t)``."""
+    t = np.sqrt(np.einsum("km,km->m", w, w))
+    small = t < tol.SO3_SMALL_ANGLE
+    half = 0.5 * t
+    s = np.where(small, 0.5 - t * t / 48.0, np.sin(half) / np.where(small, 1.0, t))
+    return np.concatenate([np.cos(half)[None], w * s], axis=0)
+
+
+def quat_mul_soa(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions ``(4, m)`` (``(w, x, y, z)`` rows), ``(4, m)`` float64."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return np.stack([
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    ])

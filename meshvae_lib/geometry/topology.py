@@ -1,6 +1,7 @@
 """Connectivity of a triangle mesh: edges, one-rings, boundaries, normals and areas.
 
-Everything here depends only on the faces ``F`` (and, for normals and areas, on positions ``V``).
+Everything here depends only on the faces ``F`` (and, for normals, areas and edge lengths, on
+positions ``V``).
 Edge order is fixed once and for all: :func:`edges` returns the undirected edges ``(i, j)`` with
 ``i < j`` in lexicographic order, and :func:`directed_edges` returns every ``(i, j)`` and ``(j, i)``
 sorted by source vertex then target vertex, which is exactly the concatenation of the one-rings
@@ -15,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from meshvae_lib.validation import check_faces, check_mesh
+
 __all__ = [
     "edges",
     "directed_edges",
@@ -27,21 +30,10 @@ __all__ = [
     "face_normals",
     "vertex_normals",
     "vertex_normal_sums",
+    "vertex_face_incidence",
     "face_areas",
+    "edge_lengths",
 ]
-
-
-def _check_faces(F) -> np.ndarray:
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3:
-        raise ValueError(f"faces must have shape (n_faces, 3), got {F.shape}")
-    if F.size and not np.issubdtype(F.dtype, np.integer):
-        if not np.all(np.equal(np.mod(F, 1), 0)):
-            raise ValueError("faces must hold integer vertex indices")
-    F = F.astype(np.int64, copy=False)
-    if F.size and F.min() < 0:
-        raise ValueError(f"faces hold a negative vertex index ({F.min()})")
-    return F
 
 
 def _face_half_edges(F: np.ndarray) -> np.ndarray:
@@ -65,7 +57,7 @@ def edges(F) -> np.ndarray:
     E : (n_edges, 2) int64
         Each edge once as ``(i, j)`` with ``i < j``, sorted lexicographically.
     """
-    F = _check_faces(F)
+    F = check_faces(F)
     he = np.sort(_face_half_edges(F), axis=1)
     return np.unique(he, axis=0) if len(he) else np.zeros((0, 2), np.int64)
 
@@ -117,7 +109,7 @@ def face_edge_indices(F) -> np.ndarray:
     FE : (n_faces, 3) int64
         ``FE[f, k]`` is the edge joining ``F[f, k+1]`` and ``F[f, k+2]`` (indices mod 3).
     """
-    F = _check_faces(F)
+    F = check_faces(F)
     E = edges(F)
     opp = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1)  # (m, 3, 2)
     return edge_index(E, opp[..., 0], opp[..., 1])
@@ -158,7 +150,7 @@ def one_rings(F, n_vertices: int | None = None) -> tuple[np.ndarray, np.ndarray]
     indices : (2 * n_edges,) int64
         Neighbour vertex ids, ascending within each ring; equal to ``directed_edges(F)[:, 1]``.
     """
-    F = _check_faces(F)
+    F = check_faces(F)
     n = int(F.max()) + 1 if F.size else 0
     if n_vertices is None:
         n_vertices = n
@@ -183,7 +175,7 @@ def boundary_edges(F) -> np.ndarray:
         Directed edges ``(i, j)`` that belong to exactly one face, in the direction that face
         traverses them (so a boundary loop is followed by chaining ``j`` to the next ``i``).
     """
-    F = _check_faces(F)
+    F = check_faces(F)
     he = _face_half_edges(F)
     key = np.sort(he, axis=1)
     _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
@@ -248,22 +240,16 @@ def boundary_loops(F) -> list[np.ndarray]:
     return loops
 
 
-def _check_positions(V, F) -> tuple[np.ndarray, np.ndarray]:
-    V = np.asarray(V, dtype=np.float64)
-    if V.ndim not in (2, 3) or V.shape[-1] != 3:
-        raise ValueError(
-            f"vertices must have shape (n_vertices, 3) or (n_meshes, n_vertices, 3), got {V.shape}"
-        )
-    F = _check_faces(F)
-    if F.size and F.max() >= V.shape[-2]:
-        raise ValueError(f"faces reference vertex {F.max()} but there are {V.shape[-2]} vertices")
-    return V, F
-
-
 def _face_cross(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """``(p1 - p0) x (p2 - p0)`` per face: ``(..., n_faces, 3)``, length twice the face area."""
     p0 = V[..., F[:, 0], :]
     return np.cross(V[..., F[:, 1], :] - p0, V[..., F[:, 2], :] - p0)
+
+
+def _unit_or_zero(c: np.ndarray) -> np.ndarray:
+    """Rows of ``c (..., 3)`` scaled to unit length; zero rows stay zero (not NaN)."""
+    norm = np.linalg.norm(c, axis=-1, keepdims=True)
+    return np.divide(c, norm, out=np.zeros_like(c), where=norm > 0)
 
 
 def face_areas(V, F) -> np.ndarray:
@@ -278,7 +264,7 @@ def face_areas(V, F) -> np.ndarray:
     -------
     A : (n_faces,) or (n_meshes, n_faces) float64
     """
-    V, F = _check_positions(V, F)
+    V, F = check_mesh(V, F)
     return 0.5 * np.linalg.norm(_face_cross(V, F), axis=-1)
 
 
@@ -295,10 +281,8 @@ def face_normals(V, F) -> np.ndarray:
     N : (n_faces, 3) or (n_meshes, n_faces, 3) float64
         Zero-area faces get the zero vector (not NaN).
     """
-    V, F = _check_positions(V, F)
-    c = _face_cross(V, F)
-    norm = np.linalg.norm(c, axis=-1, keepdims=True)
-    return np.divide(c, norm, out=np.zeros_like(c), where=norm > 0)
+    V, F = check_mesh(V, F)
+    return _unit_or_zero(_face_cross(V, F))
 
 
 def vertex_normals(V, F) -> np.ndarray:
@@ -316,10 +300,7 @@ def vertex_normals(V, F) -> np.ndarray:
     N : (n_vertices, 3) or (n_meshes, n_vertices, 3) float64
         Unit vectors; a vertex with no face (or only zero-area faces) gets the zero vector.
     """
-    V, F = _check_positions(V, F)
-    acc = vertex_normal_sums(V, F)
-    norm = np.linalg.norm(acc, axis=-1, keepdims=True)
-    return np.divide(acc, norm, out=np.zeros_like(acc), where=norm > 0)
+    return _unit_or_zero(vertex_normal_sums(V, F))
 
 
 def vertex_normal_sums(V, F) -> np.ndarray:
@@ -336,15 +317,52 @@ def vertex_normal_sums(V, F) -> np.ndarray:
         Sum of the face cross products ``(p1 - p0) x (p2 - p0)`` around each vertex; it scales with
         the square of the mesh size.
     """
-    V, F = _check_positions(V, F)
+    V, F = check_mesh(V, F)
     n = V.shape[-2]
     m = len(F)
     c = _face_cross(V, F)  # (..., m, 3)
-    inc = sp.csr_matrix(
-        (np.ones(3 * m), (F.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m)
-    )
+    inc = vertex_face_incidence(F, n)
     if V.ndim == 2:
         return np.asarray(inc @ c)
     N = V.shape[0]
     acc = (inc @ c.transpose(1, 0, 2).reshape(m, N * 3)).reshape(n, N, 3).transpose(1, 0, 2)
     return np.ascontiguousarray(acc)
+
+
+def vertex_face_incidence(F, n_vertices: int) -> sp.csr_matrix:
+    """Which faces each vertex belongs to, as a sparse 0/1 matrix.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+    n_vertices : int
+
+    Returns
+    -------
+    I : scipy.sparse.csr_matrix, shape (n_vertices, n_faces), float64
+        ``I[i, f] = 1`` when vertex ``i`` is a corner of face ``f``; ``I @ x`` sums a per-face
+        quantity ``x (n_faces, k)`` around every vertex.
+    """
+    F = check_faces(F, n_vertices=n_vertices)
+    m = len(F)
+    return sp.csr_matrix(
+        (np.ones(3 * m), (F.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n_vertices, m)
+    )
+
+
+def edge_lengths(V, F) -> np.ndarray:
+    """Lengths of the undirected edges :func:`edges` ``(F)``.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (n_meshes, n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    L : (n_edges,) or (n_meshes, n_edges) float64
+        ``L[..., e] = |p_j - p_i|`` for ``edges(F)[e] = (i, j)``.
+    """
+    V, F = check_mesh(V, F, name="V")
+    E = edges(F)
+    return np.linalg.norm(V[..., E[:, 1], :] - V[..., E[:, 0], :], axis=-1)

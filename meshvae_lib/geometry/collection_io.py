@@ -1,0 +1,283 @@
+"""Reading and writing mesh collections: a folder of mesh files (+ ``labels.csv``) or one ``.npz``.
+
+A *collection* is a set of meshes with one shared connectivity
+(:class:`~meshvae_lib.geometry.collection.MeshCollection`, see ``docs/ARCHITECTURE.md``):
+
+- an ``.npz`` with ``vertices (N, V, 3)``, ``faces (F, 3)``, optional ``names (N,)`` and one array
+  ``label_<column> (N,)`` per label column; or
+- a folder of mesh files (``.obj``, ``.ply``, ``.off``, read by
+  :func:`~meshvae_lib.geometry.mesh_files.read_mesh`) in natural order (``2.obj`` before
+  ``10.obj``), with an optional ``labels.csv`` whose first column is ``name`` (the file name
+  without extension) followed by one column per label.
+
+Every mesh is checked by :func:`~meshvae_lib.geometry.mesh_checks.validate_mesh`; a mesh whose
+connectivity differs from the first is refused with a ``ValueError`` saying what differs.
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+
+from meshvae_lib.geometry.collection import MeshCollection, default_names
+from meshvae_lib.geometry.mesh_checks import validate_mesh
+from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
+
+__all__ = ["read_collection", "write_collection", "natural_key"]
+
+logger = logging.getLogger(__name__)
+
+
+def natural_key(name: str) -> list:
+    """Sort key that orders embedded numbers by value: ``'2.obj' < '10.obj'``."""
+    return [int(t) if t.isdigit() else t.lower() for t in re.split(r"(\d+)", str(name))]
+
+
+def _parse_label_column(values: list[str]) -> np.ndarray:
+    try:
+        nums = np.array([float(v) for v in values])
+    except ValueError:
+        return np.array(values)
+    if np.all(np.isfinite(nums)) and np.all(nums == np.round(nums)) and all(
+        re.fullmatch(r"[+-]?\d+", v.strip()) for v in values
+    ):
+        return nums.astype(np.int64)
+    return nums
+
+
+def _read_labels_csv(path: Path, names: list[str]) -> dict[str, np.ndarray]:
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    rows = [r for r in rows if any(c.strip() for c in r)]
+    if not rows:
+        return {}
+    header = [h.strip() for h in rows[0]]
+    if not header or header[0] != "name":
+        raise ValueError(f"{path}: the first column must be 'name', got header {header}")
+    table = {}
+    for k, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise ValueError(
+                f"{path}: line {k} has {len(row)} fields, the header has {len(header)}"
+            )
+        table[row[0].strip()] = [c.strip() for c in row[1:]]
+    missing = [n for n in names if n not in table]
+    if missing:
+        raise ValueError(f"{path}: no row for mesh(es) {missing[:5]}")
+    unknown = sorted(set(table) - set(names))
+    if unknown:
+        raise ValueError(f"{path}: rows name meshes that are not in the folder: {unknown[:5]}")
+    return {
+        col: _parse_label_column([table[n][c] for n in names])
+        for c, col in enumerate(header[1:])
+    }
+
+
+def _check_same_connectivity(F_ref, F, name: str, ref_name: str, n_ref: int, n: int) -> None:
+    if n != n_ref:
+        raise ValueError(
+            f"{name}: has {n} vertices but {ref_name} has {n_ref}; a collection must share one "
+            "connectivity"
+        )
+    if F.shape != F_ref.shape:
+        raise ValueError(
+            f"{name}: has {len(F)} faces but {ref_name} has {len(F_ref)}; a collection must share "
+            "one connectivity"
+        )
+    diff = np.flatnonzero((F != F_ref).any(axis=1))
+    if len(diff):
+        k = int(diff[0])
+        raise ValueError(
+            f"{name}: its faces differ from those of {ref_name} ({len(diff)} faces differ; first: "
+            f"face {k} is {F[k].tolist()} vs {F_ref[k].tolist()})"
+        )
+
+
+def _validate_collection(vertices: np.ndarray, faces: np.ndarray, names, src: str,
+                         allow_degenerate: bool) -> None:
+    bad = ~np.isfinite(vertices).all(axis=(1, 2))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"{src}: mesh {names[k]!r} (index {k}) has NaN or infinite coordinates"
+        )
+    for k in range(len(vertices)):
+        validate_mesh(vertices[k], faces, name=f"{src}: mesh {names[k]!r}",
+                      allow_degenerate=allow_degenerate)
+
+
+def read_collection(path, *, allow_degenerate: bool = False, progress: bool = False
+                    ) -> MeshCollection:
+    """Read a collection: an ``.npz``, a folder of meshes (+ ``labels.csv``), or one mesh file.
+
+    Parameters
+    ----------
+    path : str or Path
+    allow_degenerate : bool
+        Accept zero-area faces (see :func:`validate_mesh`).
+    progress : bool
+        Show a progress bar (stderr) while reading a folder.
+
+    Returns
+    -------
+    MeshCollection
+        ``vertices (N, V, 3) float64``, ``faces (F, 3) int64``, ``names``, ``labels``. Names of a
+        folder's meshes are the file names without extension.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        Bad content: see :func:`validate_mesh`; meshes whose connectivity differs from the first
+        are named with what differs.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no such collection (folder, .npz or mesh file): {path}")
+    if path.is_dir():
+        return _read_folder(path, allow_degenerate, progress)
+    if path.suffix.lower() == ".npz":
+        return _read_npz(path, allow_degenerate)
+    V, F = read_mesh(path, allow_degenerate=allow_degenerate)
+    return MeshCollection(V[None], F, [path.stem], {})
+
+
+def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
+    try:
+        data = np.load(path, allow_pickle=False)
+    except Exception as exc:
+        raise ValueError(f"{path.name}: cannot be read as .npz ({exc})") from exc
+    with data:
+        for key in ("vertices", "faces"):
+            if key not in data.files:
+                raise ValueError(f"{path.name}: has no {key!r} array (found {data.files})")
+        vertices = np.asarray(data["vertices"], dtype=np.float64)
+        faces = np.asarray(data["faces"])
+        if vertices.ndim == 2:
+            vertices = vertices[None]
+        if vertices.ndim != 3 or vertices.shape[-1] != 3:
+            raise ValueError(
+                f"{path.name}: 'vertices' must have shape (N, V, 3), got {vertices.shape}"
+            )
+        if faces.ndim != 2 or faces.shape[1] != 3:
+            raise ValueError(
+                f"{path.name}: 'faces' must be triangles with shape (F, 3), got {faces.shape}"
+            )
+        n = len(vertices)
+        names = [str(s) for s in data["names"]] if "names" in data.files else default_names(n)
+        if len(names) != n:
+            raise ValueError(f"{path.name}: {len(names)} names for {n} meshes")
+        labels = {}
+        for key in data.files:
+            if key.startswith("label_"):
+                val = np.asarray(data[key])
+                if val.shape != (n,):
+                    raise ValueError(
+                        f"{path.name}: {key!r} must have shape ({n},), got {val.shape}"
+                    )
+                labels[key[len("label_"):]] = val
+    _validate_collection(vertices, faces, names, path.name, allow_degenerate)
+    return MeshCollection(vertices, faces.astype(np.int64), names, labels)
+
+
+def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshCollection:
+    files = sorted(
+        (p for p in path.iterdir() if p.is_file() and p.suffix.lower() in MESH_SUFFIXES),
+        key=lambda p: natural_key(p.name),
+    )
+    if not files:
+        raise ValueError(f"{path}: holds no mesh files ({', '.join(MESH_SUFFIXES)})")
+    stems = [p.stem for p in files]
+    if len(set(stems)) != len(stems):
+        dup = sorted({s for s in stems if stems.count(s) > 1})
+        raise ValueError(f"{path}: several files share the name(s) {dup[:5]} (different suffixes)")
+    it = files
+    if progress and len(files) > 20:
+        from tqdm.auto import tqdm
+
+        it = tqdm(files, desc="reading meshes", unit="mesh")
+    V_ref = F_ref = None
+    verts = []
+    for k, p in enumerate(it):
+        V, F = read_mesh(p, allow_degenerate=allow_degenerate)
+        if k == 0:
+            V_ref, F_ref = V, F
+        else:
+            _check_same_connectivity(F_ref, F, p.name, files[0].name, len(V_ref), len(V))
+        verts.append(V)
+    logger.info("read %d meshes from %s", len(files), path)
+    labels = {}
+    csv_path = path / "labels.csv"
+    if csv_path.is_file():
+        labels = _read_labels_csv(csv_path, stems)
+    return MeshCollection(np.stack(verts), F_ref, stems, labels)
+
+
+def write_collection(path, vertices, faces=None, names=None, labels=None) -> Path:
+    """Write a collection to an ``.npz`` (when ``path`` ends in ``.npz``) or to a folder.
+
+    A folder gets one OBJ file per mesh, named after the mesh when the names are usable as file
+    names and keep their order under natural sort (else numbered ``0000_<name>.obj``), plus
+    ``labels.csv`` when there are labels. Positions keep full float64 precision in both formats.
+
+    Parameters
+    ----------
+    path : str or Path
+    vertices : (n_meshes, n_vertices, 3) float, or a :class:`MeshCollection`
+        (then ``faces``, ``names`` and ``labels`` default to the collection's).
+    faces : (n_faces, 3) int
+    names : list of str, optional
+    labels : dict str -> (n_meshes,) array, optional
+
+    Returns
+    -------
+    path : Path
+    """
+    if isinstance(vertices, MeshCollection):
+        col = vertices
+        faces = col.faces if faces is None else faces
+        names = col.names if names is None else names
+        labels = col.labels if labels is None else labels
+        vertices = col.vertices
+    if faces is None:
+        raise ValueError("faces are required")
+    col = MeshCollection(vertices, faces, list(names) if names is not None else [],
+                         dict(labels or {}))
+    path = Path(path)
+    if path.suffix.lower() == ".npz":
+        if not path.parent.is_dir():
+            raise FileNotFoundError(f"folder does not exist: {path.parent}")
+        arrays = {"vertices": col.vertices, "faces": col.faces, "names": np.array(col.names)}
+        for key, val in col.labels.items():
+            arrays[f"label_{key}"] = val
+        np.savez_compressed(path, **arrays)
+        return path
+    path.mkdir(parents=True, exist_ok=True)
+    stems = list(col.names)
+    safe = all(re.fullmatch(r"[\w.+-]+", s) for s in stems) and len(set(stems)) == len(stems)
+    if not safe or sorted(stems, key=natural_key) != stems:
+        width = max(4, len(str(len(stems) - 1)))
+        stems = [
+            f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)}" for k, s in enumerate(stems)
+        ]
+    for V, stem in zip(col.vertices, stems):
+        write_mesh(path / f"{stem}.obj", V, col.faces)
+    if col.labels:
+        with open(path / "labels.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            keys = list(col.labels)
+            w.writerow(["name", *keys])
+            for k, stem in enumerate(stems):
+                w.writerow([stem, *[_fmt_label(col.labels[c][k]) for c in keys]])
+    return path
+
+
+def _fmt_label(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    return str(v)

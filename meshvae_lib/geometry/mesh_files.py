@@ -1,0 +1,173 @@
+"""Reading and writing single triangle meshes: OBJ, PLY and OFF.
+
+Meshes are read with trimesh without any processing (``process=False``, ``maintain_order=True``):
+vertices are never merged, reordered or dropped, so vertex ``k`` of every file is the same point of
+the shape. Polygon faces in OBJ/OFF files are refused unless ``triangulate=True``, and every mesh
+read is checked by :func:`~meshvae_lib.geometry.mesh_checks.validate_mesh`. Writing keeps float64
+positions exactly (OBJ and OFF with 17 significant digits, PLY binary float64).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from meshvae_lib.geometry.mesh_checks import validate_mesh
+from meshvae_lib.validation import check_mesh
+
+__all__ = ["MESH_SUFFIXES", "read_mesh", "write_mesh"]
+
+#: file suffixes read as meshes (in a collection folder) and written by :func:`write_mesh`.
+MESH_SUFFIXES = (".obj", ".ply", ".off")
+
+
+def _polygon_corners_in_text(path: Path) -> int:
+    """Largest number of corners of a face in an OBJ or ASCII OFF file (3 for triangle meshes)."""
+    suffix = path.suffix.lower()
+    try:
+        text = path.read_text(errors="replace")
+    except UnicodeDecodeError:  # pragma: no cover - binary file
+        return 3
+    most = 3
+    if suffix == ".obj":
+        for line in text.splitlines():
+            if line.startswith("f ") or line.startswith("f\t"):
+                most = max(most, len(line.split()) - 1)
+    elif suffix == ".off":
+        lines = [ln.split("#")[0].split() for ln in text.splitlines()]
+        lines = [ln for ln in lines if ln]
+        if not lines:
+            return 3
+        head = lines[0]
+        start = 1
+        if head[0].upper().endswith("OFF") and len(head) == 1:
+            counts = lines[1]
+            start = 2
+        else:
+            counts = head[1:] if head[0].upper().endswith("OFF") else head
+        try:
+            nv, nf = int(counts[0]), int(counts[1])
+        except (ValueError, IndexError):
+            return 3
+        for ln in lines[start + nv : start + nv + nf]:
+            try:
+                most = max(most, int(ln[0]))
+            except ValueError:
+                pass
+    return most
+
+
+def read_mesh(
+    path, *, validate: bool = True, triangulate: bool = False, allow_degenerate: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Read one triangle mesh (OBJ, PLY, OFF, or anything trimesh reads) without reordering it.
+
+    Parameters
+    ----------
+    path : str or Path
+    validate : bool
+        Run :func:`validate_mesh` (default). Turn off only to inspect a broken file.
+    triangulate : bool
+        Accept polygon faces, split into triangles by trimesh (fan triangulation). Off by default:
+        polygons raise an error, because splitting them changes the connectivity.
+    allow_degenerate : bool
+        Accept zero-area faces (see :func:`validate_mesh`).
+
+    Returns
+    -------
+    V : (n_vertices, 3) float64
+    F : (n_faces, 3) int64
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If the file is not a readable triangle mesh or fails validation.
+    """
+    import trimesh
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such mesh file: {path}")
+    if not triangulate and path.suffix.lower() in (".obj", ".off"):
+        corners = _polygon_corners_in_text(path)
+        if corners > 3:
+            raise ValueError(
+                f"{path.name}: has faces with {corners} corners; only triangle meshes are "
+                "supported (triangulate it, or read it with triangulate=True)"
+            )
+    try:
+        mesh = trimesh.load(path, process=False, maintain_order=True, force="mesh")
+    except Exception as exc:  # trimesh raises many kinds of errors for unreadable files
+        raise ValueError(f"{path.name}: cannot be read as a mesh ({exc})") from exc
+    V = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    F = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+    if F.size == 0:
+        raise ValueError(f"{path.name}: holds no triangles")
+    if validate:
+        validate_mesh(V, F, name=path.name, allow_degenerate=allow_degenerate)
+    return V, F
+
+
+def _write_obj(path: Path, V: np.ndarray, F: np.ndarray) -> None:
+    with open(path, "w") as fh:
+        fh.write(f"# {len(V)} vertices, {len(F)} faces\n")
+        np.savetxt(fh, V, fmt="v %.17g %.17g %.17g")
+        np.savetxt(fh, F + 1, fmt="f %d %d %d")
+
+
+def _write_off(path: Path, V: np.ndarray, F: np.ndarray) -> None:
+    with open(path, "w") as fh:
+        fh.write(f"OFF\n{len(V)} {len(F)} 0\n")
+        np.savetxt(fh, V, fmt="%.17g %.17g %.17g")
+        np.savetxt(fh, F, fmt="3 %d %d %d")
+
+
+def _write_ply(path: Path, V: np.ndarray, F: np.ndarray) -> None:
+    """Binary little-endian PLY with float64 vertices (trimesh's exporter writes float32)."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {len(V)}\nproperty double x\nproperty double y\nproperty double z\n"
+        f"element face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    faces = np.zeros(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    faces["n"] = 3
+    faces["v"] = F
+    with open(path, "wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(np.ascontiguousarray(V, dtype="<f8").tobytes())
+        fh.write(faces.tobytes())
+
+
+def write_mesh(path, V, F) -> Path:
+    """Write one triangle mesh; the suffix picks the format (``.obj``, ``.off``, ``.ply``).
+
+    OBJ and OFF are written as text with 17 significant digits and PLY as binary float64, so
+    positions survive a round trip exactly.
+
+    Parameters
+    ----------
+    path : str or Path
+    V : (n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    path : Path
+    """
+    path = Path(path)
+    V, F = check_mesh(V, F, batch=False)
+    suffix = path.suffix.lower()
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"folder does not exist: {path.parent}")
+    if suffix == ".obj":
+        _write_obj(path, V, F)
+    elif suffix == ".off":
+        _write_off(path, V, F)
+    elif suffix == ".ply":
+        _write_ply(path, V, F)
+    else:
+        raise ValueError(f"unknown mesh format {suffix!r} for {path}; use .obj, .off or .ply")
+    return path
