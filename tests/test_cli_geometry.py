@@ -6,8 +6,10 @@ from geometry_fixtures import bumpy, tube, twist_bend
 
 from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
 from meshvae_lib.cli import main
-from meshvae_lib.geometry.mesh_io import read_collection, write_collection, write_mesh
-from meshvae_lib.geometry.rimd import RIMDLayout, load_features
+from meshvae_lib.geometry.collection_io import read_collection, write_collection
+from meshvae_lib.geometry.mesh_files import write_mesh
+from meshvae_lib.geometry.rimd import RIMDLayout
+from meshvae_lib.geometry.rimd_files import load_features
 
 
 @pytest.fixture
@@ -37,7 +39,7 @@ def test_features_then_reconstruct_round_trip(tmp_path, data, out_name, capsys):
     np.testing.assert_array_equal(d["faces"], F)
     assert d["names"] == ["pose1", "pose2", "pose3", "pose10"]
     assert d["labels"]["pose"].tolist() == [0, 1, 2, 3]
-    assert "K = " in capsys.readouterr().err
+    assert "K = " in capsys.readouterr().out  # "wrote ..." is the command's output: stdout
     out = tmp_path / out_name
     assert main(["reconstruct", str(feats), "-o", str(out)]) == 0
     col = read_collection(out)
@@ -75,7 +77,7 @@ def test_help(capsys):
         assert "examples:" in text and "-o" in text
 
 
-def test_bad_input_gives_one_line_errors(tmp_path, data, capsys):
+def test_bad_input_gives_one_line_errors_and_exit_status_2(tmp_path, data, capsys):
     folder, verts, F = data
     cases = [
         (["features", str(tmp_path / "missing"), "-o", str(tmp_path / "f.npz")], "no such"),
@@ -96,9 +98,11 @@ def test_bad_input_gives_one_line_errors(tmp_path, data, capsys):
     cases.append((["features", str(folder), "-o", str(tmp_path / "f.npz"), "--reference",
                    str(other)], "connectivity"))
     for argv, message in cases:
-        assert main(argv) == 1, argv
-        err = capsys.readouterr().err.strip().splitlines()
-        assert message in err[-1] and err[-1].startswith("meshvae "), (argv, err)
+        assert main(argv) == 2, argv
+        captured = capsys.readouterr()
+        err = captured.err.strip().splitlines()
+        assert message in err[-1] and err[-1].startswith(f"meshvae {argv[0]}: error: "), (argv, err)
+        assert captured.out == "", argv
 
 
 @pytest.mark.parametrize("argv", [["--help"], ["synth", "--list"], ["features", "--help"], ["reconstruct", "--help"],
@@ -121,3 +125,16 @@ def test_version(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--version"])
     assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"meshvae {__version__}"
+
+
+def test_features_and_reconstruct_runs_do_not_import_torch(tmp_path, data):
+    """The geometry commands need no model: a real run, not only --help, stays without torch."""
+    import subprocess
+    import sys
+
+    folder, verts, F = data
+    feats, out = tmp_path / "f.npz", tmp_path / "r.npz"
+    for argv in (["features", str(folder), "-o", str(feats)], ["reconstruct", str(feats), "-o", str(out)]):
+        code = f"import sys\nfrom meshvae_lib.cli import main\nrc = main({argv!r})\nprint('TORCH', rc, 'torch' in sys.modules)"
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+        assert res.stdout.strip().splitlines()[-1] == "TORCH 0 False", (argv, res.stdout[-500:], res.stderr[-500:])

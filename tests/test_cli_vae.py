@@ -7,7 +7,9 @@ import pytest
 import torch
 
 from meshvae_lib.cli import main
-from meshvae_lib.geometry.mesh_io import MeshCollection, read_collection, write_collection, write_mesh
+from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.geometry.collection_io import read_collection, write_collection
+from meshvae_lib.geometry.mesh_files import write_mesh
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -102,27 +104,28 @@ def test_conditional_train_and_generate(data, tmp_path):
                  "-o", str(tmp_path / "s.npz")]) == 0
 
 
-def test_user_errors_exit_1_with_a_message(data, tmp_path, capsys):
+def test_user_errors_exit_2_with_a_message(data, tmp_path, capsys):
     root, path, model, coll = data
     capsys.readouterr()
     bad = tmp_path / "bad.pt"
     bad.write_bytes(b"not a checkpoint at all")
-    assert main(["evaluate", str(bad), str(path)]) == 1
+    assert main(["evaluate", str(bad), str(path)]) == 2
     assert "checkpoint" in capsys.readouterr().err
-    assert main(["generate", str(model), "-n", "2", "-o", str(tmp_path / "x.npz"), "--condition", "pose=a"]) == 1
+    assert main(["generate", str(model), "-n", "2", "-o", str(tmp_path / "x.npz"), "--condition", "pose=a"]) == 2
     assert "without labels" in capsys.readouterr().err
-    assert main(["interpolate", str(model), "0", "99", "--data", str(path), "-o", str(tmp_path / "y.npz")]) == 1
-    assert "outside" in capsys.readouterr().err
-    assert main(["interpolate", str(model), "0", "1", "-o", str(tmp_path / "y.npz")]) == 1
+    assert main(["interpolate", str(model), "0", "99", "--data", str(path), "-o", str(tmp_path / "y.npz")]) == 2
+    assert "B 99 is out of range for 16 meshes" in capsys.readouterr().err
+    assert main(["interpolate", str(model), "0", "1", "-o", str(tmp_path / "y.npz")]) == 2
     assert "--data" in capsys.readouterr().err
     other = write_collection(tmp_path / "other.npz", _strips(n=3, nx=6))
-    assert main(["evaluate", str(model), str(other)]) == 1
+    assert main(["evaluate", str(model), str(other)]) == 2
     assert "vertices" in capsys.readouterr().err
     assert main(["train", str(path), "-o", str(tmp_path / "z.pt"), "--labels", "colour", "--epochs", "1",
-                 "--no-progress"]) == 1
+                 "--no-progress"]) == 2
     assert "colour" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
+    with pytest.raises(SystemExit) as exc:
         main(["train", str(path), "-o", str(tmp_path / "z.pt"), "--sigma-object", "0,-1"])
+    assert exc.value.code == 2 and "positive numbers" in capsys.readouterr().err
 
 
 def test_help_texts_describe_the_commands(capsys):
@@ -152,7 +155,7 @@ def test_evaluate_reports_the_pca_baseline(data, capsys):
     assert "linear PCA on coordinates (1 components" in out and "model / PCA" in out
     # without a file, DATA must be the training collection with held-out meshes
     other = write_collection(root / "few.npz", MeshCollection(coll.vertices[:5], coll.faces))
-    assert main(["evaluate", str(model), str(other), "--pca"]) == 1
+    assert main(["evaluate", str(model), str(other), "--pca"]) == 2
     assert "--pca TRAIN" in capsys.readouterr().err
 
 
@@ -164,7 +167,8 @@ def test_evaluate_with_codes_fitted_to_the_vertices(data, capsys):
     assert main(["evaluate", str(model), str(path), "--held-out", "--fit-latent", "2", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["fit_iterations"] == 2 and res["mean_vertex_error"] <= plain + 1e-12
-    assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 1
+    assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 2
+    assert "--fit-latent must be >= 0" in capsys.readouterr().err
 
 
 def test_train_and_evaluate_accept_degenerate_faces_only_when_asked(tmp_path, capsys):
@@ -175,12 +179,12 @@ def test_train_and_evaluate_accept_degenerate_faces_only_when_asked(tmp_path, ca
     out = tmp_path / "m.pt"
     args = ["train", str(path), "-o", str(out), "--epochs", "2", "--latent", "3", "--no-progress"]
     capsys.readouterr()
-    assert main(args) == 1
+    assert main(args) == 2
     err = capsys.readouterr().err
     assert "zero-area" in err and "--allow-degenerate" in err
     assert main(args + ["--allow-degenerate"]) == 0 and out.exists()
-    assert main(["evaluate", str(out), str(path)]) == 1
-    capsys.readouterr()
+    assert main(["evaluate", str(out), str(path)]) == 2
+    assert "zero-area" in capsys.readouterr().err
     assert main(["evaluate", str(out), str(path), "--allow-degenerate", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["n_meshes"] == 8 and np.isfinite(res["mean_vertex_error"])

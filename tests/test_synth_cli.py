@@ -52,13 +52,15 @@ def test_writes_folder_of_obj_files_and_labels_csv(tmp_path):
     np.testing.assert_array_equal(f - 1, ref.faces)
 
 
-def test_bad_input_is_one_line_error(tmp_path, capsys):
-    assert main(["synth", "nosuch", "-o", str(tmp_path / "x.npz")]) == 1
+def test_bad_input_is_one_line_error_with_exit_status_2(tmp_path, capsys):
+    assert main(["synth", "nosuch", "-o", str(tmp_path / "x.npz")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "nosuch" in err and "scape" in err
-    assert main(["synth", "bar"]) == 1
+    assert main(["synth", "bar"]) == 2
     assert "-o" in capsys.readouterr().err
-    assert main(["synth", "bar", "-o", str(tmp_path / "x.npz"), "--resolution", "5"]) == 1
+    assert main(["synth", "bar", "-o", str(tmp_path / "x.npz"), "--resolution", "5"]) == 2
     assert "5" in capsys.readouterr().err
-    assert main(["synth", "bar", "-o", str(tmp_path / "missing" / "x.npz")]) == 1
+    assert main(["synth", "bar", "-o", str(tmp_path / "missing" / "x.npz")]) == 2
     assert "missing" in capsys.readouterr().err
+    assert main(["synth", "bar", "-o", str(tmp_path / "x.npz"), "--seed", "-1"]) == 2
+    assert "--seed must be non-negative" in capsys.readouterr().err

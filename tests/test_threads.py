@@ -51,5 +51,5 @@ def test_cli_reads_the_variable_and_reports_a_bad_value(monkeypatch, capsys):
     from meshvae_lib.cli import main
 
     monkeypatch.setenv(ENV_VAR, "zero")
-    assert main(["synth", "--list"]) == 1
+    assert main(["synth", "--list"]) == 2   # a bad value: exit 2
     assert f"{ENV_VAR} must be a positive integer" in capsys.readouterr().err

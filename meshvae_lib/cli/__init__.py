@@ -1,7 +1,18 @@
 """The ``meshvae`` command line: one sub-command per module in this package.
 
 Each sub-command lives in ``meshvae_lib/cli/<name>.py`` and defines ``add_parser(subparsers)``, which
-adds its parser and sets ``func`` (called with the parsed namespace, returns an exit code).
+adds its parser (with :func:`add_command`) and sets ``func`` (called with the parsed namespace,
+returns an exit code). This module holds what the commands share, importable without numpy or
+torch so that ``--help`` stays fast:
+
+- the conventions, applied in one place, :func:`main`: exit status ``EXIT_OK`` (0),
+  ``EXIT_FAILURE`` (1: the command failed on valid input, :class:`CommandFailed` or an I/O error)
+  and ``EXIT_USAGE`` (2: bad usage or a bad value, :class:`UsageError`, ``ValueError`` or a missing
+  file); results and "wrote ..." lines go to stdout (:func:`result`), progress, warnings and
+  errors to stderr (:func:`note`);
+- the shared arguments (:func:`add_model_argument`, :func:`add_output_argument`,
+  :func:`add_allow_degenerate`) and the one resolver of a mesh given on the command line as an
+  index, a mesh name or a file (:func:`resolve_mesh`).
 """
 
 from __future__ import annotations
@@ -11,6 +22,9 @@ import importlib
 import logging
 import os
 import sys
+from dataclasses import dataclass
+
+logger = logging.getLogger(__name__)
 
 #: sub-commands, in the order ``meshvae --help`` lists them.
 COMMANDS = (
@@ -23,6 +37,85 @@ COMMANDS = (
     "interpolate",
 )
 
+#: exit status: success.
+EXIT_OK = 0
+#: exit status: the command failed on valid input (training diverged, an I/O error while writing, ...).
+EXIT_FAILURE = 1
+#: exit status: bad usage or a bad value, for the user to fix in the command (argparse's own code).
+EXIT_USAGE = 2
+
+EPILOG = """\
+exit status:
+  0  success
+  1  the command failed on valid input: e.g. training diverged, or an I/O error while writing
+  2  bad usage or a bad value, to fix in the command: an unknown option, a value out of range, a
+     missing or unknown file or mesh name, a damaged checkpoint, a model that does not fit the data
+
+output: results and "wrote ..." lines go to stdout; progress bars, warnings and errors
+(one line: "meshvae COMMAND: error: ...") go to stderr.
+
+Run `meshvae COMMAND --help` for a command's options and examples.
+"""
+
+
+class UsageError(Exception):
+    """A bad value in the command (exit status 2). ``ValueError`` and a missing file count too."""
+
+
+class CommandFailed(Exception):
+    """The command failed on valid input (exit status 1), e.g. training diverged."""
+
+
+#: exceptions that mean "fix the command": a bad value, a file or folder that is not there (or is
+#: the wrong kind). Any other OSError is a failure on valid input (a full disk, a permission).
+USAGE_ERRORS = (UsageError, ValueError, FileNotFoundError, NotADirectoryError, IsADirectoryError)
+
+
+def exit_status(exc: BaseException) -> int:
+    """The exit status of a command that raised ``exc``: ``EXIT_USAGE`` or ``EXIT_FAILURE``."""
+    if isinstance(exc, CommandFailed):
+        return EXIT_FAILURE
+    return EXIT_USAGE if isinstance(exc, USAGE_ERRORS) else EXIT_FAILURE
+
+
+def result(text: str) -> None:
+    """A line of the command's output (results, "wrote ..."): stdout."""
+    print(text, file=sys.stdout)
+
+
+def note(text: str) -> None:
+    """A progress or warning line, not part of the output: stderr."""
+    print(text, file=sys.stderr)
+
+
+# --- shared arguments --------------------------------------------------------------------------
+
+
+def add_command(subparsers, name: str, help: str, description: str, run) -> argparse.ArgumentParser:
+    """A sub-command parser that calls ``run(args)``; its description (with its examples) keeps
+    its line breaks."""
+    p = subparsers.add_parser(name, help=help, description=description,
+                              formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.set_defaults(func=run)
+    return p
+
+
+def check_at_least(value: int, minimum: int, option: str, why: str = "") -> None:
+    """:class:`UsageError` unless ``value >= minimum`` (``why``: a reason for the message)."""
+    if value < minimum:
+        raise UsageError(f"{option} must be >= {minimum}{f' ({why})' if why else ''}, got {value}")
+
+
+def add_model_argument(parser: argparse.ArgumentParser) -> None:
+    """The ``MODEL.pt`` positional of every command that reads a checkpoint."""
+    parser.add_argument("model", metavar="MODEL.pt", help="checkpoint written by `meshvae train`")
+
+
+def add_output_argument(parser: argparse.ArgumentParser, metavar: str = "OUT",
+                        help: str = ".npz file or folder for OBJ files") -> None:
+    """The required ``-o/--output`` of every command that writes something."""
+    parser.add_argument("-o", "--output", required=True, metavar=metavar, help=help)
+
 
 def add_allow_degenerate(parser: argparse.ArgumentParser) -> None:
     """The ``--allow-degenerate`` flag of every command that reads meshes (``read_collection``)."""
@@ -30,16 +123,86 @@ def add_allow_degenerate(parser: argparse.ArgumentParser) -> None:
                         help="accept zero-area faces (they get the fallback cotangent weight)")
 
 
+# --- a mesh named on the command line ----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ChosenMesh:
+    """A mesh picked by :func:`resolve_mesh`: its vertices (n, 3), its name, and either its index
+    into the collection or the file it was read from."""
+
+    vertices: object
+    name: str
+    index: int | None = None
+    file: str | None = None
+
+    def describe(self) -> str:
+        return f"file {self.file}" if self.file is not None else f"mesh {self.name!r} (index {self.index})"
+
+
+def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: int | None = None,
+                 owner: str = "the collection's", allow_degenerate: bool = False,
+                 hint: str = "") -> ChosenMesh:
+    """The mesh that ``spec`` names: an index into ``collection`` (negative counts from the end), a
+    mesh name of ``collection``, or else a mesh file (OBJ/PLY/OFF). Without a collection only a
+    file.
+
+    option : what the command line calls it (``--reference``, ``A``), for the messages.
+    faces, n_vertices : the connectivity a mesh file must have (default: the collection's);
+        ``owner`` says whose it is in the message ("the collection's", "the model's").
+    hint : appended to the message when ``spec`` names nothing.
+
+    Raises :class:`UsageError` for an index out of range, a ``spec`` that names nothing, or a file
+    with another connectivity.
+    """
+    if collection is not None:
+        n = len(collection)
+        try:
+            k = int(spec)
+        except ValueError:
+            k = collection.names.index(spec) if spec in collection.names else None
+        if k is not None:
+            if not -n <= k < n:
+                raise UsageError(f"{option} {k} is out of range for {n} meshes (0..{n - 1}, or -{n}..-1"
+                                 " from the end)")
+            k %= n
+            return ChosenMesh(collection.vertices[k], collection.names[k], index=k)
+        if faces is None:
+            faces, n_vertices = collection.faces, collection.n_vertices
+    from pathlib import Path
+
+    path = Path(spec)
+    if not path.is_file():
+        what = "neither an index, a mesh name of the collection, nor" if collection is not None else "not"
+        raise UsageError(f"{option} {spec!r} is {what} a mesh file{hint}")
+    import numpy as np
+
+    from meshvae_lib.geometry.mesh_files import read_mesh
+
+    V, F = read_mesh(path, allow_degenerate=allow_degenerate)
+    if faces is not None:
+        faces = np.asarray(faces)
+        if len(V) != n_vertices or F.shape != faces.shape or np.any(F != faces):
+            raise UsageError(f"{option} {path.name}: its connectivity ({len(V)} vertices, {len(F)} faces)"
+                             f" differs from {owner} ({n_vertices} vertices, {len(faces)} faces)")
+    return ChosenMesh(V, path.stem, file=path.name)
+
+
+# --- the command line --------------------------------------------------------------------------
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="meshvae",
-        description="Mesh variational autoencoders (Tan et al., CVPR 2018): RIMD features, "
+        description="Mesh variational autoencoders (Tan et al., CVPR 2018): RIMD features,\n"
         "reconstruction, training and applications on your own deforming meshes.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     from meshvae_lib import __version__
 
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="log progress details (and show the traceback of an unexpected error)")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         try:
@@ -53,6 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit status (argparse errors, ``--help`` and ``--version``
+    raise ``SystemExit`` as argparse does: 2 and 0)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -60,18 +225,24 @@ def main(argv: list[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     if not getattr(args, "func", None):
-        parser.print_help()
-        return 2
-    from meshvae_lib.model.threads import ENV_VAR, configure_threads
-
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
     try:
+        from meshvae_lib.model.threads import ENV_VAR, configure_threads
+
         if os.environ.get(ENV_VAR, "").strip():  # only then, so that commands without torch stay fast
             configure_threads()
-        return int(args.func(args) or 0)
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        # Errors from bad input are the user's to fix: one clear line, no traceback.
-        print(f"meshvae {args.command}: error: {exc}", file=sys.stderr)
-        return 1
+        return int(args.func(args) or EXIT_OK)
+    except Exception as exc:  # one line on stderr, no traceback; the status says whose fault it is
+        status = exit_status(exc)
+        expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
+        text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
+        if not expected:
+            text += f" (run `meshvae -v {args.command} ...` for the traceback)"
+        if args.verbose:
+            logger.error("traceback of the error below", exc_info=exc)
+        print(f"meshvae {args.command}: error: {text}", file=sys.stderr)
+        return status
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from . import add_allow_degenerate
+from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, result
 
 DESCRIPTION = """\
 Encode every mesh of DATA to its latent mean, decode it, align it rigidly to the original and
@@ -28,9 +28,8 @@ the same error as the model.
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("evaluate", help="per-vertex reconstruction error of a model on a collection",
-                              description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("model", metavar="MODEL.pt", help="checkpoint written by `meshvae train`")
+    p = add_command(subparsers, "evaluate", "per-vertex reconstruction error of a model on a collection", DESCRIPTION, run)
+    add_model_argument(p)
     p.add_argument("data", metavar="DATA", help="collection (.npz or folder) with the model's mesh")
     p.add_argument("--held-out", action="store_true", help="only the meshes held out in training")
     p.add_argument("--json", action="store_true",
@@ -45,19 +44,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--pca-components", type=int, default=None, metavar="K",
                    help="principal components of the PCA baseline (default: all the training meshes span)")
     add_allow_degenerate(p)
-    p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
     from meshvae_lib.model.checkpoint import load_model
     from meshvae_lib.model.evaluation import evaluate_model
-    from meshvae_lib.geometry.mesh_io import read_collection
+    from meshvae_lib.geometry.collection_io import read_collection
 
+    check_at_least(args.fit_latent, 0, "--fit-latent")
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
-    if args.fit_latent < 0:
-        raise ValueError(f"--fit-latent must be >= 0, got {args.fit_latent}")
     res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent)
     if args.pca is not None:
         import numpy as np
@@ -71,22 +68,22 @@ def run(args) -> int:
         else:
             mask = np.asarray(model.holdout_mask_, dtype=bool)
             if len(mask) != len(collection) or not mask.any():
-                raise ValueError("--pca without a file needs DATA to be the model's training collection with"
+                raise UsageError("--pca without a file needs DATA to be the model's training collection with"
                                  " held-out meshes; give the training meshes: --pca TRAIN")
             V_train = np.asarray(collection.vertices, dtype=np.float64)[~mask]
         V_eval = np.asarray(collection.vertices, dtype=np.float64)[res["indices"]]
         res["pca"] = pca_baseline(V_train, V_eval, n_components=args.pca_components)
     if args.json:
-        print(json.dumps(res, indent=2))
+        result(json.dumps(res, indent=2))
     else:
         worst = max(range(res["n_meshes"]), key=lambda i: res["per_mesh"][i])
-        print(f"mean per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
-              f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal; features {res['features']}"
-              + (f"; codes fitted to the vertices, {args.fit_latent} steps" if args.fit_latent else "") + ")")
-        print(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
+        result(f"mean per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
+               f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal; features {res['features']}"
+               + (f"; codes fitted to the vertices, {args.fit_latent} steps" if args.fit_latent else "") + ")")
+        result(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
         if "pca" in res:
             pca = res["pca"]
-            print(f"linear PCA on coordinates ({pca['n_components']} components, fitted on the training meshes):"
-                  f" {pca['mean_vertex_error']:.6g} ({100 * pca['relative_error']:.3f}% of the diagonal);"
-                  f" model / PCA = {res['mean_vertex_error'] / max(pca['mean_vertex_error'], 1e-300):.3g}")
+            result(f"linear PCA on coordinates ({pca['n_components']} components, fitted on the training meshes):"
+                   f" {pca['mean_vertex_error']:.6g} ({100 * pca['relative_error']:.3f}% of the diagonal);"
+                   f" model / PCA = {res['mean_vertex_error'] / max(pca['mean_vertex_error'], 1e-300):.3g}")
     return 0

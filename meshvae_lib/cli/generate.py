@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
+from . import UsageError, add_command, add_model_argument, add_output_argument, check_at_least, result
 
 DESCRIPTION = """\
 Draw N latent vectors from the prior N(0, diag(sigma_object^2)) and decode them into meshes
@@ -26,32 +26,31 @@ def _condition(text: str) -> tuple[str, str]:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("generate", help="generate new meshes from a trained model",
-                              description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("model", metavar="MODEL.pt", help="checkpoint written by `meshvae train`")
+    p = add_command(subparsers, "generate", "generate new meshes from a trained model", DESCRIPTION, run)
+    add_model_argument(p)
     p.add_argument("-n", type=int, default=10, metavar="N", help="number of meshes (default 10)")
-    p.add_argument("-o", "--output", required=True, metavar="OUT", help=".npz file or folder for OBJ files")
+    add_output_argument(p)
     p.add_argument("--condition", type=_condition, action="append", default=[], metavar="COLUMN=VALUE",
                    help="label value for a conditional model (repeatable)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
-    p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
-    from meshvae_lib.model.checkpoint import load_model
-    from meshvae_lib.geometry.mesh_io import write_collection
+    import numpy as np
 
-    if args.n < 1:
-        raise ValueError(f"-n must be >= 1, got {args.n}")
+    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.geometry.collection_io import write_collection
+
+    check_at_least(args.n, 1, "-n")
     model = load_model(args.model)
     condition = dict(args.condition)
     if condition and not model.is_conditional:
-        raise ValueError("this model was trained without labels; --condition needs a conditional model"
+        raise UsageError("this model was trained without labels; --condition needs a conditional model"
                          " (meshvae train ... --labels COLUMN)")
     V = model.generate(args.n, seed=args.seed, condition=condition or None)
     labels = {col: np.asarray([val] * args.n) for col, val in condition.items()}
     out = write_collection(args.output, V, model.faces,
                            names=[f"generated_{i:04d}" for i in range(args.n)], labels=labels or None)
-    print(f"wrote {args.n} meshes to {out}")
+    result(f"wrote {args.n} meshes to {out}")
     return 0

@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-import numpy as np
-
-from . import add_allow_degenerate
+from . import (UsageError, add_allow_degenerate, add_command, add_model_argument, add_output_argument,
+               check_at_least, resolve_mesh, result)
 
 DESCRIPTION = """\
 Encode meshes A and B to their latent means, interpolate linearly in the latent space and decode
@@ -23,71 +21,48 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("interpolate", help="interpolate between two meshes in the latent space",
-                              description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("model", metavar="MODEL.pt", help="checkpoint written by `meshvae train`")
-    p.add_argument("a", metavar="A", help="start: mesh file, or index into --data")
-    p.add_argument("b", metavar="B", help="end: mesh file, or index into --data")
+    p = add_command(subparsers, "interpolate", "interpolate between two meshes in the latent space", DESCRIPTION, run)
+    add_model_argument(p)
+    p.add_argument("a", metavar="A", help="start: mesh file, or index (or mesh name) into --data")
+    p.add_argument("b", metavar="B", help="end: mesh file, or index (or mesh name) into --data")
     p.add_argument("--steps", type=int, default=10, metavar="S", help="meshes in the sequence, ends included (default 10)")
-    p.add_argument("-o", "--output", required=True, metavar="OUT", help=".npz file or folder for OBJ files")
+    add_output_argument(p)
     p.add_argument("--data", default=None, metavar="DATA", help="collection that A and B index into")
     add_allow_degenerate(p)
-    p.set_defaults(func=run)
     return p
 
 
-def _resolve(spec: str, collection, what: str):
-    """-> (vertices (n, 3), label row dict or None, name)."""
-    from meshvae_lib.geometry.mesh_io import read_mesh
-
-    if collection is not None:
-        try:
-            i = int(spec)
-        except ValueError:
-            i = None
-        if i is None and spec in collection.names:
-            i = collection.names.index(spec)
-        if i is not None:
-            n = len(collection)
-            if not -n <= i < n:
-                raise ValueError(f"{what} index {i} is outside 0..{n - 1} of {n} meshes")
-            labels = {k: np.asarray(v)[[i]] for k, v in collection.labels.items()}
-            return collection.vertices[i], labels, collection.names[i]
-    path = Path(spec)
-    if not path.exists():
-        hint = "" if collection is not None else " (to use an index, give --data DATA)"
-        raise FileNotFoundError(f"{what}: no mesh file {spec!r}{hint}")
-    V, F = read_mesh(path)
-    return V, None, path.stem, F
-
-
 def run(args) -> int:
-    from meshvae_lib.model.checkpoint import load_model
-    from meshvae_lib.geometry.mesh_io import read_collection, write_collection
+    import numpy as np
 
-    if args.steps < 2:
-        raise ValueError(f"--steps must be >= 2 (both ends are included), got {args.steps}")
+    from meshvae_lib.applications.interpolation import interpolate_latent, linear_steps
+    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.geometry.collection_io import read_collection, write_collection
+
+    check_at_least(args.steps, 2, "--steps", "both ends are included")
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate) if args.data else None
     model = load_model(args.model, collection)
-    ends = []
-    for spec, what in ((args.a, "A"), (args.b, "B")):
-        res = _resolve(spec, collection, what)
-        V, labels, name = res[:3]
-        model.extractor_.check_compatible(V[None], res[3] if len(res) > 3 else None)
-        ends.append((V, labels, name))
-    cond = None
+    ends = [resolve_mesh(spec, collection, what, faces=model.faces, n_vertices=len(model.reference_vertices),
+                         owner="the model's", allow_degenerate=args.allow_degenerate,
+                         hint="" if collection is not None else " (to use an index, give --data DATA)")
+            for spec, what in ((args.a, "A"), (args.b, "B"))]
+    c_ends = c_path = None  # a conditional model: the two ends' condition vectors and the path between them
     if model.is_conditional:
-        if ends[0][1] is None or ends[1][1] is None:
-            raise ValueError("this model is conditional: give A and B as indices into --data so that"
+        if any(e.index is None for e in ends):
+            raise UsageError("this model is conditional: give A and B as indices into --data so that"
                              " their labels are known")
-        c = [model.conditions_.transform(e[1]) for e in ends]
-    z = [model.encode_meshes(e[0][None], conditions=c[i] if model.is_conditional else None) for i, e in enumerate(ends)]
-    t = np.linspace(0.0, 1.0, args.steps)[:, None]
-    Z = (1 - t) * z[0] + t * z[1]
-    if model.is_conditional:
-        cond = ((1 - t) * c[0] + t * c[1]).astype(np.float32)
-    V = model.decode_latent(Z, conditions=cond)
+        c_ends = [model.condition_vector({col: collection.labels[col][e.index] for col in model.labels})
+                  for e in ends]  # (1, C) each
+        c_path = linear_steps(c_ends[0][0], c_ends[1][0], args.steps).astype(np.float32)
+
+    def encode(V):
+        return model.encode_meshes(V, conditions=None if c_ends is None else np.vstack(c_ends))
+
+    def decode(Z):
+        return model.decode_latent(Z, conditions=c_path)
+
+    _, V = interpolate_latent(encode, decode, ends[0].vertices, ends[1].vertices, args.steps)
     names = [f"step_{i:03d}" for i in range(args.steps)]
     out = write_collection(args.output, V, model.faces, names=names)
-    print(f"wrote {args.steps} meshes from {ends[0][2]} to {ends[1][2]} to {out}")
+    result(f"wrote {args.steps} meshes from {ends[0].name} to {ends[1].name} to {out}")
     return 0

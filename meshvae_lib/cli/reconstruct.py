@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import logging
-import sys
 from pathlib import Path
 
 from meshvae_lib.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+from . import UsageError, add_command, add_output_argument, check_at_least, result
 
 logger = logging.getLogger(__name__)
 
@@ -30,12 +30,9 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "reconstruct", help="meshes from RIMD features", description=DESCRIPTION,
-        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = add_command(subparsers, "reconstruct", "meshes from RIMD features", DESCRIPTION, run)
     p.add_argument("features", metavar="FEATS.npz", help="feature file from `meshvae features`")
-    p.add_argument("-o", "--output", required=True, metavar="OUT",
-                   help="folder to write OBJ files to, or an .npz collection file")
+    add_output_argument(p, help="folder to write OBJ files to, or an .npz collection file")
     p.add_argument("--method", choices=RECONSTRUCTION_METHODS, default="exact",
                    help="position solve (default: exact)")
     p.add_argument("--rotations", choices=ROTATION_RECOVERY, default="global",
@@ -43,27 +40,25 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    "to noise) or the reference's spanning-tree walk")
     p.add_argument("--iterations", type=int, default=0, metavar="N",
                    help="--method paper only: the reference's local/global rounds (default 0)")
-    p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
-    from meshvae_lib.geometry.mesh_io import write_collection
+    from meshvae_lib.geometry.collection_io import write_collection
     from meshvae_lib.geometry.reconstruction import RIMDReconstructor
-    from meshvae_lib.geometry.rimd import load_features
+    from meshvae_lib.geometry.rimd_files import load_features
 
     out = Path(args.output)
+    check_at_least(args.iterations, 0, "--iterations")
     if out.suffix.lower() == ".npz" and not out.parent.is_dir():
-        raise FileNotFoundError(f"folder does not exist: {out.parent}")
+        raise UsageError(f"folder does not exist: {out.parent}")
     if out.exists() and not out.is_dir() and out.suffix.lower() != ".npz":
-        raise ValueError(f"{out} exists and is not a folder")
-    if args.iterations < 0:
-        raise ValueError(f"--iterations must be >= 0, got {args.iterations}")
+        raise UsageError(f"{out} exists and is not a folder")
     data = load_features(args.features)
     rec = RIMDReconstructor(data["reference"], data["faces"], method=args.method,
                             layout=data["layout"], rotations=args.rotations,
                             iterations=args.iterations)
     V = rec.reconstruct(data["features"], progress=len(data["features"]) > 8)
     write_collection(out, V, data["faces"], data["names"], data["labels"])
-    print(f"wrote {len(V)} meshes ({args.method} method) to {out}", file=sys.stderr)
+    result(f"wrote {len(V)} meshes ({args.method} method) to {out}")
     return 0

@@ -7,6 +7,8 @@ import logging
 import time
 from pathlib import Path
 
+from . import UsageError, add_command, result
+
 logger = logging.getLogger(__name__)
 
 DESCRIPTION = """\
@@ -28,9 +30,8 @@ examples:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "synth", help="write a procedural deforming-mesh collection (scape, dyna, flag, ...)",
-        description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = add_command(subparsers, "synth", "write a procedural deforming-mesh collection (scape, dyna, flag, ...)",
+                    DESCRIPTION, run)
     p.add_argument("name", nargs="?", metavar="NAME", help="collection name (see --list)")
     p.add_argument("-o", "--output", metavar="OUT",
                    help="file ending in .npz, or a folder for OBJ files plus labels.csv")
@@ -38,7 +39,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--resolution", type=int, default=None, metavar="R",
                    help="approximate vertex count of the template (default: the collection's)")
     p.add_argument("--list", action="store_true", help="list the collections, one a line, and exit")
-    p.set_defaults(func=run)
     return p
 
 
@@ -47,28 +47,28 @@ def run(args) -> int:
 
     if args.list:
         for name, description in list_collections():
-            print(f"{name}\t{description}")
+            result(f"{name}\t{description}")
         return 0
     names = [n for n, _ in list_collections()]
     if not args.name:
-        raise ValueError(f"give a collection NAME (one of {', '.join(names)}) or --list")
+        raise UsageError(f"give a collection NAME (one of {', '.join(names)}) or --list")
     if args.name not in names:
-        raise ValueError(f"unknown collection {args.name!r}; choose one of {', '.join(names)}")
+        raise UsageError(f"unknown collection {args.name!r}; choose one of {', '.join(names)}")
     if not args.output:
-        raise ValueError("give the output with -o OUT (a .npz file or a folder)")
+        raise UsageError("give the output with -o OUT (a .npz file or a folder)")
     if args.seed < 0:
-        raise ValueError(f"--seed must be non-negative, got {args.seed}")
+        raise UsageError(f"--seed must be non-negative, got {args.seed}")
     out = Path(args.output)
     if out.suffix.lower() == ".npz" and not out.parent.exists():
-        raise FileNotFoundError(f"folder does not exist: {out.parent}")
+        raise UsageError(f"folder does not exist: {out.parent}")
     if out.exists() and not out.is_dir() and out.suffix.lower() != ".npz":
-        raise ValueError(f"OUT must end in .npz or name a folder, got the file {out}")
+        raise UsageError(f"OUT must end in .npz or name a folder, got the file {out}")
     start = time.perf_counter()
     col = make_collection(args.name, seed=args.seed, resolution=args.resolution)
     logger.info("built %s in %.2f s", args.name, time.perf_counter() - start)
-    from meshvae_lib.geometry.mesh_io import write_collection
+    from meshvae_lib.geometry.collection_io import write_collection
 
     write_collection(out, col.vertices, col.faces, names=col.names, labels=col.labels)
-    print(f"wrote {args.name}: {len(col.vertices)} meshes x {col.vertices.shape[1]} vertices, "
-          f"{len(col.faces)} faces, labels {', '.join(col.labels) or '(none)'} -> {out}")
+    result(f"wrote {args.name}: {len(col.vertices)} meshes x {col.vertices.shape[1]} vertices, "
+           f"{len(col.faces)} faces, labels {', '.join(col.labels) or '(none)'} -> {out}")
     return 0

@@ -7,7 +7,8 @@ import logging
 
 from meshvae_lib.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
-from . import add_allow_degenerate
+from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
+               note, result)
 
 logger = logging.getLogger(__name__)
 
@@ -42,10 +43,9 @@ def _floats(text: str) -> list[float]:
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("train", help="train a mesh VAE and save a checkpoint", description=DESCRIPTION,
-                              formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
-    p.add_argument("-o", "--output", required=True, metavar="MODEL.pt", help="checkpoint file to write")
+    add_output_argument(p, "MODEL.pt", "checkpoint file to write")
     p.add_argument("--features", choices=FEATURE_KINDS, default="rimd",
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
                    " rigidly aligned or raw vertex coordinates (default: rimd)")
@@ -78,21 +78,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--device", default="auto", help="auto (GPU when available), cpu, cuda, ... (default auto)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     add_allow_degenerate(p)
-    p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
     from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.model.training import TrainingDiverged
     from meshvae_lib.model.evaluation import evaluate_model
-    from meshvae_lib.geometry.mesh_io import read_collection
-    from meshvae_lib.model.training import TrainConfig, default_hidden
+    from meshvae_lib.geometry.collection_io import read_collection
+    from meshvae_lib.model.train_config import TrainConfig, default_hidden
 
-    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
-    if args.latent < 1:
-        raise ValueError(f"--latent must be >= 1, got {args.latent}")
+    check_at_least(args.latent, 1, "--latent")
     if args.sigma_object is not None and len(args.sigma_object) > args.latent:
-        raise ValueError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent}")
+        raise UsageError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent}")
+    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     d = TrainConfig()
     epochs = args.epochs if args.epochs is not None else d.epochs
     hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
@@ -102,20 +101,24 @@ def run(args) -> int:
                          early_stopping=False if args.no_early_stopping else None,
                          device=args.device, progress=not args.no_progress)
     at_most = "at most " if config.resolved_early_stopping(config.uses_pca_init(len(args.labels))) else ""
-    print(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
-          f" latent {args.latent}, hidden {list(hidden)}, {at_most}{epochs} epochs")
+    note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
+         f" latent {args.latent}, hidden {list(hidden)}, {at_most}{epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
-                         holdout_every=args.holdout_every, reference_index=args.reference).fit(collection)
+                         holdout_every=args.holdout_every, reference_index=args.reference)
+    try:
+        model.fit(collection)
+    except TrainingDiverged as exc:  # valid input, failed training: not the command's fault
+        raise CommandFailed(str(exc)) from exc
     model.save(args.output)
     last = model.history_[-1]
     if model.selection_ is not None:
-        print(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
-              f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
-    print(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
-          f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.network_.n_features}")
+        result(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
+               f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
+    result(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
+           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.network_.n_features}")
     if model.holdout_mask_.any():
         res = evaluate_model(model, collection, held_out_only=True)
-        print(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
-              f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal)")
-    print(f"wrote {args.output}")
+        result(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
+               f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal)")
+    result(f"wrote {args.output}")
     return 0
