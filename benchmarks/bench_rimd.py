@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT / "tests"))  # the procedural meshes of the test fix
 from geometry_fixtures import bumpy, tube, twist_bend  # noqa: E402
 
 from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align  # noqa: E402
-from meshvae_lib.geometry.mesh_io import read_collection  # noqa: E402
+from meshvae_lib.geometry.collection_io import read_collection  # noqa: E402
 from meshvae_lib.geometry.reconstruction import RIMDReconstructor  # noqa: E402
 from meshvae_lib.geometry.rimd import RIMDEncoder  # noqa: E402
 

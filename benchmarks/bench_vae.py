@@ -17,7 +17,8 @@ import time
 import numpy as np
 import torch
 
-from meshvae_lib.model.training import TrainConfig, train_vae
+from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.model.training import train_vae
 from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
 
 

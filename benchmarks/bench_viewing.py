@@ -52,7 +52,7 @@ def _real_model(resolution: int):
 
         from data_synth.registry import make_collection
         from meshvae_lib.model.meshvae_model import MeshVAEModel
-        from meshvae_lib.model.training import TrainConfig
+        from meshvae_lib.model.train_config import TrainConfig
     except ImportError as err:
         return None, f"real model unavailable ({err})"
     torch.set_num_threads(2)

@@ -8,7 +8,7 @@ were recorded (``results.json`` holds the definitions' fingerprint, the commit, 
 the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
-  ``meshvae_lib.paper.experiments``), plus renderings: ``generation_meshes.png`` (generated meshes over
+  ``meshvae_lib.paper``), plus renderings: ``generation_meshes.png`` (generated meshes over
   their nearest training meshes), ``interpolation_meshes.png`` (Fig. 4), ``exploration_level1.png``
   and ``exploration_level2.png`` (Fig. 8);
 - ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
@@ -34,17 +34,17 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from meshvae_lib.paper import experiments as exps  # noqa: E402
+from meshvae_lib import paper  # noqa: E402
 
 SHORT = {
-    "table1": exps.latent_size_table,
-    "table2": exps.feature_table,
-    "table3": exps.robustness_table,
-    "loss": exps.loss_table,
-    "embedding": exps.embedding_table,
-    "generation": exps.generation_table,
-    "interpolation": exps.interpolation_table,
-    "exploration": exps.exploration_table,
+    "table1": paper.latent_size_table,
+    "table2": paper.feature_table,
+    "table3": paper.robustness_table,
+    "loss": paper.loss_table,
+    "embedding": paper.embedding_table,
+    "generation": paper.generation_table,
+    "interpolation": paper.interpolation_table,
+    "exploration": paper.exploration_table,
 }
 
 
@@ -142,7 +142,7 @@ def _provenance(args, settings) -> dict:
         cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    return {"definition_fingerprint": exps.definition_fingerprint(settings), "commit": git("rev-parse", "HEAD"),
+    return {"definition_fingerprint": paper.definition_fingerprint(settings), "commit": git("rev-parse", "HEAD"),
             "uncommitted_changes": bool(git("status", "--porcelain", "--untracked-files=no")),
             "versions": {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
                          "torch": torch.__version__},
@@ -165,7 +165,7 @@ def main(argv=None) -> int:
     torch.set_num_threads(args.threads)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    settings = exps.ExperimentSettings.quick() if args.quick else exps.ExperimentSettings()
+    settings = paper.ExperimentSettings.quick() if args.quick else paper.ExperimentSettings()
     chosen = [s.strip() for s in args.only.split(",") if s.strip()] or list(SHORT)
     unknown = [c for c in chosen if c not in SHORT]
     if unknown:

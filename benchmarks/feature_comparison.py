@@ -38,8 +38,9 @@ import torch
 
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
-from meshvae_lib.geometry.mesh_io import MeshCollection
-from meshvae_lib.model.training import TrainConfig, holdout_mask
+from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.model.training import holdout_mask
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 REAL = ("samba", "pdance", "pcow")

@@ -2,7 +2,7 @@
 
 The library is a set of small modules, one concept each; import what you need::
 
-    from meshvae_lib.geometry.mesh_io import read_collection
+    from meshvae_lib.geometry.collection_io import read_collection
     from meshvae_lib.geometry.rimd import rimd_features
     from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 

@@ -13,6 +13,10 @@ FEATURE_KINDS = ("coords", "aligned", "rimd")
 LAYOUTS = ("paper", "compact")
 #: how a sigma_object prior enters the latent cost (``vae.kl_divergence``).
 PRIOR_FORMS = ("exact", "sibling")
+#: the decoder's last activation (``vae.MeshVAE(output=...)``).
+OUTPUTS = ("tanh", "sigmoid")
+#: the reconstruction terms of ``vae.vae_loss`` (``loss=...``; "bce" needs the sigmoid output).
+LOSSES = ("mse", "bce")
 #: network initialisations (``training.TrainConfig.init``) and the default.
 INIT_MODES = ("pca", "random")
 DEFAULT_INIT = "pca"

@@ -8,8 +8,8 @@ import torch
 
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.checkpoint import load_model, write_checkpoint
-from meshvae_lib.geometry.mesh_io import MeshCollection
-from meshvae_lib.model.training import TrainConfig
+from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.model.train_config import TrainConfig
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -223,3 +223,30 @@ def test_generate_returns_the_draws_behind_its_meshes(model):
     assert c is None and np.array_equal(model.generate(3, seed=7), V)
     with pytest.raises(ValueError, match="unconditional"):
         model.generate(2, condition={"mode": "arc"})
+
+
+def test_network_options_round_trip_through_the_checkpoint(collection, tmp_path):
+    """A floored deviation and a sigmoid output (the cross-entropy model) are the network's own
+    options: load_model rebuilds the same network, and a file of format 1 (without them) loads
+    with the defaults."""
+    cfg = TrainConfig(epochs=4, latent_dim=4, batch_size=8, progress=False, init="random", sigma_floor=1e-4,
+                      output="sigmoid", loss="bce")
+    model = MeshVAEModel("rimd", cfg, holdout_every=4).fit(collection)
+    assert model.network_.sigma_floor == 1e-4 and model.network_.output == "sigmoid"
+    loaded = load_model(model.save(tmp_path / "bce.pt"), collection)
+    assert loaded.network_.config() == model.network_.config()
+    assert loaded.train_config_.loss == "bce" and loaded.train_config_.output == "sigmoid"
+    z = model.sample_latent(5, seed=2)
+    np.testing.assert_array_equal(loaded.decode_latent(z), model.decode_latent(z))
+    np.testing.assert_array_equal(loaded.encode_meshes(collection, return_sigma=True)[1],
+                                  model.encode_meshes(collection, return_sigma=True)[1])
+    # decoded meshes are in the data's units: the sigmoid's range is mapped back to Eq. 3's
+    spread = np.abs(collection.vertices).max()
+    assert np.all(np.abs(model.reconstruct(collection.vertices[:3])) < 3 * spread)
+    old = torch.load(tmp_path / "bce.pt", weights_only=True)
+    old["version"] = 1
+    for key in ("sigma_floor", "output"):
+        del old["network_config"][key]
+    torch.save(old, tmp_path / "v1.pt")
+    v1 = load_model(tmp_path / "v1.pt")
+    assert v1.network_.sigma_floor == 0.0 and v1.network_.output == "tanh"

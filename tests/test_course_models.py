@@ -11,7 +11,7 @@ import pytest
 
 from meshvae_lib.course import models as cm
 from meshvae_lib.course.commands import main
-from meshvae_lib.model.training import TrainConfig
+from meshvae_lib.model.train_config import TrainConfig
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from meshvae_lib.applications import embedding as emb
+from meshvae_lib.applications import retrieval as ret
 
 # ---------------------------------------------------------------------------------------------
 # NPE
@@ -138,14 +139,14 @@ def test_average_precision_hand_computed():
     # 1D embedding, positions 0, 1, 3, 7; labels a, b, a, a.
     Y = np.array([[0.0], [1.0], [3.0], [7.0]])
     lab = np.array(["a", "b", "a", "a"])
-    ap = emb.average_precision(Y, lab)
+    ap = ret.average_precision(Y, lab)
     # query 0: ranking 1(b), 2(a), 3(a) -> hits at ranks 2, 3: AP = (1/2 + 2/3) / 2 = 7/12
     # query 1: no other b -> NaN
     # query 2: distances 3, 2, 4 -> ranking 1(b), 0(a), 3(a): AP = (1/2 + 2/3) / 2 = 7/12
     # query 3: distances 7, 6, 4 -> ranking 2(a), 1(b), 0(a): AP = (1 + 2/3) / 2 = 5/6
     np.testing.assert_allclose(ap[[0, 2, 3]], [7 / 12, 7 / 12, 5 / 6], atol=1e-12)
     assert np.isnan(ap[1])
-    res = emb.precision_recall_curve(Y, lab, n_points=4)
+    res = ret.precision_recall_curve(Y, lab, n_points=4)
     assert res.auc["label"] == pytest.approx((7 / 12 + 7 / 12 + 5 / 6) / 3, abs=1e-12)
     # curve at recall 0.25, 0.5 -> first hit; 0.75, 1.0 -> second hit. Mean over queries 0, 2, 3.
     np.testing.assert_allclose(
@@ -158,7 +159,7 @@ def test_auc_against_sklearn_average_precision(rng):
 
     Y = rng.normal(size=(50, 2))
     lab = rng.integers(0, 4, size=50)
-    ours = emb.average_precision(Y, lab)
+    ours = ret.average_precision(Y, lab)
     ref = []
     for q in range(50):
         others = np.delete(np.arange(50), q)
@@ -170,11 +171,11 @@ def test_auc_against_sklearn_average_precision(rng):
 def test_curve_area_converges_to_auc(rng):
     Y = rng.normal(size=(60, 2))
     labels = {"shape": rng.integers(0, 3, 60), "motion": rng.integers(0, 5, 60)}
-    res = emb.precision_recall_curve(Y, labels, n_points=20000)
+    res = ret.precision_recall_curve(Y, labels, n_points=20000)
     for k in ("shape", "motion", "mean"):
         assert res.precision[k].mean() == pytest.approx(res.auc[k], abs=2e-3)
     assert res.auc["mean"] == pytest.approx((res.auc["shape"] + res.auc["motion"]) / 2, abs=1e-12)
-    assert emb.retrieval_auc(Y, labels) == pytest.approx(res.auc["mean"], abs=1e-12)
+    assert ret.retrieval_auc(Y, labels) == pytest.approx(res.auc["mean"], abs=1e-12)
 
 
 def test_auc_extremes_and_joint_relevance():
@@ -182,11 +183,11 @@ def test_auc_extremes_and_joint_relevance():
     shape = np.repeat([0, 1, 2], 6)
     motion = np.tile(np.repeat([0, 1], 3), 3)
     Y = np.column_stack([shape * 100.0 + motion * 10.0, np.arange(18) * 0.01])
-    assert emb.retrieval_auc(Y, shape) == pytest.approx(1.0)
-    assert emb.retrieval_auc(Y, {"shape": shape, "motion": motion}, relevance="joint") == pytest.approx(1.0)
+    assert ret.retrieval_auc(Y, shape) == pytest.approx(1.0)
+    assert ret.retrieval_auc(Y, {"shape": shape, "motion": motion}, relevance="joint") == pytest.approx(1.0)
     # motion is not clustered at the top level: below 1 when scored separately
-    assert emb.retrieval_auc(Y, motion) < 0.9
+    assert ret.retrieval_auc(Y, motion) < 0.9
     with pytest.raises(ValueError, match="relevance"):
-        emb.precision_recall_curve(Y, shape, relevance="both")
+        ret.precision_recall_curve(Y, shape, relevance="both")
     with pytest.raises(ValueError, match=r"\(18,\)"):
-        emb.precision_recall_curve(Y, shape[:5])
+        ret.precision_recall_curve(Y, shape[:5])

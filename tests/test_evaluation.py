@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from meshvae_lib.model.evaluation import evaluate_model, per_vertex_error
-from meshvae_lib.geometry.mesh_io import MeshCollection
+from meshvae_lib.geometry.collection import MeshCollection
 
 
 def test_error_of_rigidly_moved_copy_is_zero_after_alignment(rng):
@@ -141,7 +141,7 @@ def test_default_rimd_model_generalises_better_than_coordinate_pca_and_the_paper
     from data_synth.registry import make_collection
     from meshvae_lib.model.meshvae_model import MeshVAEModel
     from meshvae_lib.model.evaluation import pca_baseline
-    from meshvae_lib.model.training import TrainConfig
+    from meshvae_lib.model.train_config import TrainConfig
 
     coll = make_collection("scape", seed=0, resolution=300)
     latent = 16

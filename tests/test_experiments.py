@@ -12,7 +12,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from meshvae_lib.paper import experiments as exps
+from meshvae_lib import paper
+from meshvae_lib import tolerances as tol
+from meshvae_lib.paper import protocol
+from meshvae_lib.paper.robustness import density_resolutions
 
 
 @dataclass
@@ -46,7 +49,7 @@ def _make(resolution=None):
                        {"shape": np.array(shape), "motion": np.array(motion)})
 
 
-SETTINGS = exps.ExperimentSettings(resolution=None, max_meshes=None, train_steps=8, min_epochs=3, max_epochs=4,
+SETTINGS = paper.ExperimentSettings(resolution=None, max_meshes=None, train_steps=8, min_epochs=3, max_epochs=4,
                                    batch_size=8, latent_dim=8, holdout_every=5, seed=0, embedding_steps=10)
 
 
@@ -66,25 +69,25 @@ def _finite_positive(xs):
 
 
 def test_settings_epochs_and_quick():
-    s = exps.ExperimentSettings(train_steps=600, batch_size=32, min_epochs=20, max_epochs=600)
+    s = paper.ExperimentSettings(train_steps=600, batch_size=32, min_epochs=20, max_epochs=600)
     assert s.epochs_for(120) == 160  # ceil(600 * 32 / 120)
     assert s.epochs_for(10_000) == 20 and s.epochs_for(1) == 600
-    q = exps.ExperimentSettings.quick()
+    q = paper.ExperimentSettings.quick()
     assert q.train_steps < s.train_steps and q.max_meshes <= 40
 
 
 def test_load_collection_thins_evenly(coll):
-    s = exps.ExperimentSettings(max_meshes=7)
-    d = exps.load_collection(coll, s)
+    s = paper.ExperimentSettings(max_meshes=7)
+    d = paper.load_collection(coll, s)
     idx = np.round(np.linspace(0, 39, 7)).astype(int)
     np.testing.assert_array_equal(d.vertices, coll.vertices[idx])
     np.testing.assert_array_equal(d.labels["shape"], coll.labels["shape"][idx])
     with pytest.raises(ValueError, match="expected a collection"):
-        exps.load_collection(3.5, s)
+        paper.load_collection(3.5, s)
 
 
 def test_latent_size_table(coll, cache):
-    t = exps.latent_size_table([coll], latent_dims=(2, 8), settings=SETTINGS, cache=cache)
+    t = paper.latent_size_table([coll], latent_dims=(2, 8), settings=SETTINGS, cache=cache)
     assert t.columns == ["collection [N]", "ours D=2", "ours D=8", "paper D=2", "paper D=8"]
     assert len(t.rows) == 1 and t.rows[0][0] == "ellipsoids [40]"
     errs = t.data["errors"]["ellipsoids"]
@@ -92,8 +95,8 @@ def test_latent_size_table(coll, cache):
     # the numbers are the held-out errors of the cached models
     from meshvae_lib.model.evaluation import evaluate_model
 
-    d = exps.load_collection(coll, SETTINGS, cache=cache)
-    model = exps._train(d, SETTINGS, cache, latent_dim=8)
+    d = paper.load_collection(coll, SETTINGS, cache=cache)
+    model = protocol.train_model(d, SETTINGS, cache, latent_dim=8)
     assert evaluate_model(model, d, held_out_only=True)["mean_vertex_error"] == pytest.approx(errs[1], rel=1e-12)
     md = t.to_markdown()
     assert "| ellipsoids [40] |" in md and md.count("\n|") >= 3
@@ -102,8 +105,8 @@ def test_latent_size_table(coll, cache):
 
 def test_latent_size_table_is_deterministic(coll):
     s = dataclasses_replace(SETTINGS, max_epochs=3)
-    a = exps.latent_size_table([coll], latent_dims=(4,), settings=s)
-    b = exps.latent_size_table([coll], latent_dims=(4,), settings=s)
+    a = paper.latent_size_table([coll], latent_dims=(4,), settings=s)
+    b = paper.latent_size_table([coll], latent_dims=(4,), settings=s)
     assert a.data["errors"] == b.data["errors"]
 
 
@@ -114,7 +117,7 @@ def dataclasses_replace(obj, **kw):
 
 
 def test_feature_table(coll, cache):
-    t = exps.feature_table([coll], settings=SETTINGS, cache=cache)
+    t = paper.feature_table([coll], settings=SETTINGS, cache=cache)
     errs = t.data["errors"]["ellipsoids"]
     assert set(errs) == {"coords", "aligned", "rimd"} and _finite_positive(list(errs.values()))
     row = t.as_dicts()[0]
@@ -124,7 +127,7 @@ def test_feature_table(coll, cache):
 
 
 def test_robustness_table_reference_and_density(cache):
-    t = exps.robustness_table(_make, references=(0, 4), resolutions=(50, 200), settings=SETTINGS, cache=cache)
+    t = paper.robustness_table(_make, references=(0, 4), resolutions=(50, 200), settings=SETTINGS, cache=cache)
     runs = t.data["runs"]
     assert [r["n_vertices"] for r in runs] == [42, 162, 42]
     assert runs[2]["reference"] == 3  # index 4 is held out (every 5th): moved to the previous mesh
@@ -136,16 +139,16 @@ def test_robustness_table_reference_and_density(cache):
 def test_density_resolutions_stay_inside_data_synth_limits():
     from data_synth.constants import MAX_RESOLUTION, MIN_RESOLUTION
 
-    assert exps._density_resolutions(400) == (400, 320, 500)  # the paper's 0.8x / 1.25x
-    quick = exps._density_resolutions(exps.ExperimentSettings.quick().resolution)
+    assert density_resolutions(400) == (400, 320, 500)  # the paper's 0.8x / 1.25x
+    quick = density_resolutions(paper.ExperimentSettings.quick().resolution)
     assert quick[0] == 300 and len(set(quick)) == 3
     assert all(MIN_RESOLUTION <= r <= MAX_RESOLUTION for r in quick)
-    top = exps._density_resolutions(MAX_RESOLUTION)
+    top = density_resolutions(MAX_RESOLUTION)
     assert all(r <= MAX_RESOLUTION for r in top) and len(set(top)) == 3
 
 
 def test_loss_table(coll, cache):
-    t = exps.loss_table(coll, epoch_factor=2, settings=SETTINGS, cache=cache)
+    t = paper.loss_table(coll, epoch_factor=2, settings=SETTINGS, cache=cache)
     assert len(t.rows) == 2
     mse_epochs, bce_epochs = t.rows[0][1], t.rows[1][1]
     assert bce_epochs == 2 * mse_epochs == len(t.data["bce_history"])
@@ -155,7 +158,7 @@ def test_loss_table(coll, cache):
 
 
 def test_embedding_table(coll, cache):
-    t = exps.embedding_table(coll, settings=SETTINGS, cache=cache, seeds=(0, 1, 2), hidden=(8,))
+    t = paper.embedding_table(coll, settings=SETTINGS, cache=cache, seeds=(0, 1, 2), hidden=(8,))
     assert t.column("method") == ["sigma_object VAE", "t-SNE", "PCA", "NPE", "sigma_object VAE, exact KL",
                                   "sigma_object VAE, alpha 1e6, no hidden layer"]
     # the VAE row is the seed with the median AUC, the spread column covers every seed
@@ -163,13 +166,13 @@ def test_embedding_table(coll, cache):
     assert len(per_seed) == 3 and t.rows[0][1] == pytest.approx(sorted(per_seed)[1], abs=1e-12)
     assert t.rows[0][-2] == f"{min(per_seed):.4f}-{max(per_seed):.4f}"
     assert t.data["alpha"] == 1e3 and t.data["hidden"] == (8,)
-    again = exps.embedding_table(coll, settings=SETTINGS, seeds=(0, 1, 2), hidden=(8,), compare_exact=False,
+    again = paper.embedding_table(coll, settings=SETTINGS, seeds=(0, 1, 2), hidden=(8,), compare_exact=False,
                                  compare_paper_defaults=False)
     assert again.data["seed_aucs"]["sigma_object VAE"] == per_seed  # seeded: the same numbers without the cache
     aucs = np.array(t.column("AUC (mean)"), dtype=float)
     assert np.all((aucs > 0) & (aucs <= 1))
     # the table's number is the retrieval AUC of the stored embedding
-    from meshvae_lib.applications.embedding import retrieval_auc
+    from meshvae_lib.applications.retrieval import retrieval_auc
 
     Y = t.data["embeddings"]["PCA"]
     assert retrieval_auc(Y, t.data["labels"]) == pytest.approx(aucs[2], abs=1e-12)
@@ -180,7 +183,7 @@ def test_embedding_table(coll, cache):
 
 
 def test_generation_table(coll, cache):
-    t = exps.generation_table(coll, n=4, conditional_collection=coll, condition_column="shape",
+    t = paper.generation_table(coll, n=4, conditional_collection=coll, condition_column="shape",
                               settings=SETTINGS, cache=cache)
     assert len(t.rows) == 3
     res = t.data["unconditional"]
@@ -191,7 +194,7 @@ def test_generation_table(coll, cache):
 
 
 def test_interpolation_table(coll, cache):
-    t = exps.interpolation_table(coll, n_steps=4, settings=SETTINGS, cache=cache)
+    t = paper.interpolation_table(coll, n_steps=4, settings=SETTINGS, cache=cache)
     assert t.column("method") == ["latent (ours)", "linear RIMD", "linear coordinates", "latent, generated ends"]
     seqs = t.data["sequences"]
     a, b = t.data["pair"]
@@ -200,14 +203,59 @@ def test_interpolation_table(coll, cache):
     assert all(isinstance(r[1], int) and r[3] >= 0 for r in t.rows)
 
 
-def test_stable_network_floors_the_deviation_and_train_checks_the_prior_form():
+def test_the_experiments_network_floors_the_deviation_and_train_checks_the_prior_form(coll, cache):
     import torch
 
-    net = exps._stable_vae_class()(6, 3)
-    _, s = net.encode(torch.full((2, 6), -1e4))
-    assert torch.all(s >= exps.tol.SIGMA_FLOOR)  # the deviation the KL sees is never 0
+    d = paper.load_collection(coll, SETTINGS, cache=cache)
+    net = protocol.train_model(d, SETTINGS, cache).network_
+    assert type(net).__name__ == "MeshVAE" and net.sigma_floor == tol.SIGMA_FLOOR and net.output == "tanh"
+    _, s = net.encode(torch.full((2, net.n_features), -1e4))
+    assert torch.all(s >= tol.SIGMA_FLOOR)  # the deviation the KL sees is never 0
     with pytest.raises(ValueError, match="prior_form"):
-        exps._train(exps.load_collection(_make(), SETTINGS), SETTINGS, None, sigma_object=(0.1,), prior="x")
+        protocol.train_model(paper.load_collection(_make(), SETTINGS), SETTINGS, None, sigma_object=(0.1,), prior="x")
+
+
+def test_the_model_cache_is_keyed_by_the_collections_content():
+    """Equal collections share a model; other data never gets it, whatever the objects' ids."""
+    cache = {}
+    a = _make()
+    m = protocol.train_model(paper.load_collection(a, SETTINGS, cache=cache), SETTINGS, cache)
+    twin = _Collection(a.vertices.copy(), a.faces.copy(), {k: v.copy() for k, v in a.labels.items()})
+    assert protocol.train_model(paper.load_collection(twin, SETTINGS, cache=cache), SETTINGS, cache) is m
+    del a, twin
+    other = _make()
+    other.vertices = other.vertices * 1.1  # a new object, perhaps at a freed one's address: other data
+    d = paper.load_collection(other, SETTINGS, cache=cache)
+    m2 = protocol.train_model(d, SETTINGS, cache)
+    assert m2 is not m and d.fingerprint != paper.load_collection(_make(), SETTINGS).fingerprint
+    relabelled = _make()
+    relabelled.labels["shape"] = relabelled.labels["shape"][::-1].copy()
+    assert paper.load_collection(relabelled, SETTINGS).fingerprint != paper.load_collection(_make(), SETTINGS).fingerprint
+    # a callable entry is made once and kept alive by its cache entry (its id cannot be reused)
+    made = []
+    make = lambda res: made.append(res) or _make(res)  # noqa: E731
+    first = paper.load_collection(make, SETTINGS, cache=cache)
+    assert paper.load_collection(make, SETTINGS, cache=cache) is first and len(made) == 1
+    assert any(v[0] is make for v in cache.values() if isinstance(v, tuple))
+
+
+def test_plots_show_what_the_tables_print(coll, cache):
+    """Table 1's figure: the absolute errors the table prints, on a log axis; the bar plots read the
+    rows, so a table read back from results.json (no data) plots too."""
+    t = paper.latent_size_table([coll], latent_dims=(2, 8), settings=SETTINGS, cache=cache)
+    ax = t.plot().axes[0]
+    assert ax.get_ylabel() == "held-out per-vertex error (mesh units)" and ax.get_yscale() == "log"
+    (line,) = ax.get_lines()
+    np.testing.assert_array_equal(line.get_ydata(), t.rows[0][1:3])
+    bare = paper.ExperimentTable(t.name, t.title, t.columns, t.rows)
+    assert bare.plot().axes[0].get_lines()[0].get_ydata().tolist() == t.rows[0][1:3]
+    t3 = paper.ExperimentTable("table3_robustness", "t3", ["base mesh", "points", "error", "paper error"],
+                               [["No. 1", 42, 1e-3, 2.77e-4], ["No. 4", 42, 2e-3, None]])
+    ax3 = t3.plot().axes[0]
+    assert ax3.get_ylabel() == "held-out per-vertex error (mesh units)"
+    assert [p.get_height() for p in ax3.patches[:2]] == [1e-3, 2e-3]
+    with pytest.raises(ValueError, match="no plot"):
+        paper.ExperimentTable("nope", "t", ["a"]).plot()
 
 
 RESULTS = __import__("pathlib").Path(__file__).resolve().parents[1] / "docs" / "results" / "results.json"
@@ -215,10 +263,10 @@ RESULTS = __import__("pathlib").Path(__file__).resolve().parents[1] / "docs" / "
 
 def test_the_committed_full_results_are_current():
     """docs/results holds a full `make experiments` run (notebook 09 shows it). When the experiments'
-    definitions (meshvae_lib/paper/experiments.py or the default settings) change, it is stale: rerun
+    definitions (any module of meshvae_lib/paper, or the default settings) change, it is stale: rerun
     `make experiments` and commit docs/results."""
-    res = exps.read_results(RESULTS)
-    assert res.provenance["preset"] == "full" and res.settings == exps.ExperimentSettings()
+    res = paper.read_results(RESULTS)
+    assert res.provenance["preset"] == "full" and res.settings == paper.ExperimentSettings()
     assert res.is_current(), "the experiments changed after docs/results was recorded: run `make experiments`"
     assert {"table1", "table2", "table3", "loss"} <= set(res.tables)
     for key in ("commit", "versions", "machine"):
@@ -228,24 +276,37 @@ def test_the_committed_full_results_are_current():
 def test_definition_fingerprint_and_read_results(tmp_path):
     import json
 
-    s = exps.ExperimentSettings()
-    fp = exps.definition_fingerprint(s)
-    assert fp == exps.definition_fingerprint(exps.ExperimentSettings()) and len(fp) == 64
-    assert exps.definition_fingerprint(exps.ExperimentSettings(train_steps=301)) != fp
+    s = paper.ExperimentSettings()
+    fp = paper.definition_fingerprint(s)
+    assert fp == paper.definition_fingerprint(paper.ExperimentSettings()) and len(fp) == 64
+    assert paper.definition_fingerprint(paper.ExperimentSettings(train_steps=301)) != fp
+    # it covers the source of every module of meshvae_lib/paper, by relative path in sorted order
+    import dataclasses
+    import hashlib
+    from pathlib import Path
+
+    root = Path(paper.__file__).parent
+    rels = sorted(p.relative_to(root).as_posix() for p in root.rglob("*.py"))
+    assert {"__init__.py", "settings.py", "tables.py", "protocol.py", "plots.py", "loss.py"} <= set(rels)
+    h = hashlib.sha256()
+    for rel in rels:
+        h.update(f"{rel}\0".encode() + (root / rel).read_bytes())
+    h.update(json.dumps(dataclasses.asdict(s), sort_keys=True).encode())
+    assert fp == h.hexdigest()
     table = {"name": "table1", "title": "t", "columns": ["a", "b"], "rows": [["x", 1.5]], "notes": [], "seconds": 2.0}
     raw = {"settings": __import__("dataclasses").asdict(s), "seconds": 3.0, "done": True, "failed": [],
            "tables": {"table1": table}, "provenance": {"definition_fingerprint": fp}}
     path = tmp_path / "results.json"
     path.write_text(json.dumps(raw))
-    res = exps.read_results(path)
+    res = paper.read_results(path)
     assert res.is_current() and res.tables["table1"].as_dicts() == [{"a": "x", "b": 1.5}]
     path.write_text(json.dumps({**raw, "provenance": {"definition_fingerprint": "0" * 64}}))
-    assert not exps.read_results(path).is_current()
+    assert not paper.read_results(path).is_current()
     path.write_text(json.dumps({**raw, "done": False}))
     with pytest.raises(ValueError, match="unfinished"):
-        exps.read_results(path)
+        paper.read_results(path)
     path.write_text(json.dumps({"tables": {}}))
     with pytest.raises(ValueError, match="lacks"):
-        exps.read_results(path)
+        paper.read_results(path)
     with pytest.raises(FileNotFoundError, match="make experiments"):
-        exps.read_results(tmp_path / "nope.json")
+        paper.read_results(tmp_path / "nope.json")

@@ -8,7 +8,7 @@ from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.geometry.topology import edges
-from meshvae_lib.model.training import default_hidden
+from meshvae_lib.model.train_config import default_hidden
 from meshvae_lib.defaults import HIDDEN_COORDS
 
 

@@ -38,7 +38,7 @@ def _tiny_collection(n=12, seed=0):
 
 def _tiny_model(coll, labels=(), seed=0):
     from meshvae_lib.model.meshvae_model import MeshVAEModel
-    from meshvae_lib.model.training import TrainConfig
+    from meshvae_lib.model.train_config import TrainConfig
 
     cfg = TrainConfig(epochs=5, batch_size=4, latent_dim=3, seed=seed, device="cpu", progress=False)
     return MeshVAEModel(features="coords", config=cfg, labels=labels).fit(coll)
@@ -47,7 +47,7 @@ def _tiny_model(coll, labels=(), seed=0):
 def test_prior_draws_shape_seed_and_scale():
     """MeshVAEModel.sample_latent draws N(0, diag(sigma_object^2)) with the exact prior form."""
     from meshvae_lib.model.meshvae_model import MeshVAEModel
-    from meshvae_lib.model.training import TrainConfig
+    from meshvae_lib.model.train_config import TrainConfig
 
     cfg = TrainConfig(epochs=2, batch_size=4, latent_dim=3, seed=0, device="cpu", progress=False,
                       sigma_object=(0.1, 0.5, 1.0), prior_form="exact", init="random")

@@ -23,16 +23,10 @@ ROOT = Path(__file__).resolve().parents[1]
 N_FIGURES, N_TABLES, N_EQUATIONS = 8, 3, 5
 REFERENCE = re.compile(r"\b(Figs?\.|Figures?|Tables?|Eqs?\.|Equations?)\s*\(?(\d+)([a-z]?)\)?"
                        r"((?:\s*(?:,|and|-|–|/)\s*\(?\d+\)?)*)")
-#: experiments.py's source is part of the committed results' fingerprint (docs/results): its
-#: docstrings keep the older figure numbers (6 for interpolation, 9 for exploration) until the next
-#: `make experiments` run records them afresh.
-EXEMPT = {"meshvae_lib/paper/experiments.py"}
-
-
 def _files() -> list[str]:
     files = sorted(ROOT.glob("notebooks/[0-9][0-9]_*.ipynb")) + sorted(ROOT.glob("docs/*.md")) + [ROOT / "README.md"]
     files += sorted(ROOT.glob("meshvae_lib/**/*.py")) + sorted(ROOT.glob("benchmarks/*.py"))
-    return [p.relative_to(ROOT).as_posix() for p in files if p.relative_to(ROOT).as_posix() not in EXEMPT]
+    return [p.relative_to(ROOT).as_posix() for p in files]
 
 
 def _text(rel: str) -> str:

@@ -5,7 +5,8 @@ import pytest
 import torch
 
 from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.model.training import TrainConfig, holdout_mask, pad_sigma_object, resolve_device, train_vae
+from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.model.training import holdout_mask, pad_sigma_object, resolve_device, train_vae
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -236,3 +237,63 @@ def test_which_networks_get_the_pca_start_and_new_config_checks():
             TrainConfig(**bad)
     with pytest.raises(ValueError, match="early stopping"):
         train_vae(X, config=TrainConfig(early_stopping=True, progress=False), model=MeshVAE(30, 4))
+
+
+def test_bce_loss_by_hand_on_a_tiny_batch():
+    """loss="bce": targets mapped from Eq. 3's [-0.9, 0.9] to [0.1, 0.9], cross-entropy summed over the
+    features and averaged over the meshes, the logged MSE back in Eq. 3 units."""
+    from meshvae_lib.model.training import _evaluate, from_output_range, to_output_range
+
+    cfg = TrainConfig(loss="bce", output="sigmoid", init="random", progress=False, latent_dim=2)
+    x = torch.tensor([[-0.9, 0.0, 0.9], [0.9, 0.0, -0.9]])
+    np.testing.assert_allclose(to_output_range(x, 0.9).numpy(), [[0.1, 0.5, 0.9], [0.9, 0.5, 0.1]], atol=1e-7)
+    np.testing.assert_allclose(from_output_range(to_output_range(x, 0.9), 0.9).numpy(), x.numpy(), atol=1e-6)
+    net = MeshVAE(3, 2, output="sigmoid")
+    p_hat = torch.tensor([0.2, 0.5, 0.6])
+    with torch.no_grad():  # mu = 0, sigma = 2 sigmoid(0) = 1 (KL 0), decoded p_hat for every mesh
+        for p in net.parameters():
+            p.zero_()
+        net.decoder_head.bias.copy_(torch.log(p_hat / (1 - p_hat)))
+    ln = np.log
+    row1 = -(0.1 * ln(0.2) + 0.9 * ln(0.8)) - ln(0.5) - (0.9 * ln(0.6) + 0.1 * ln(0.4))
+    row2 = -(0.9 * ln(0.2) + 0.1 * ln(0.8)) - ln(0.5) - (0.1 * ln(0.6) + 0.9 * ln(0.4))
+    got = _evaluate(net, x, None, cfg, None)
+    assert got["val_reconstruction"] == pytest.approx((row1 + row2) / 2, rel=1e-5) == pytest.approx(2.3230, rel=1e-4)
+    assert got["val_kl"] == pytest.approx(0.0, abs=1e-6)
+    assert got["val_total"] == pytest.approx(got["val_reconstruction"] + got["val_kl"], rel=1e-6)
+    # decoded rows back in [-0.9, 0.9]: -0.675, 0, 0.225 against the targets
+    assert got["val_mse"] == pytest.approx((0.225**2 + 0.675**2 + 1.575**2 + 1.125**2) / 6, rel=1e-5)
+
+
+def test_bce_training_lowers_the_loss_with_the_same_loop():
+    X = _data()
+    cfg = TrainConfig(epochs=60, latent_dim=6, batch_size=8, progress=False, eval_every=20, loss="bce",
+                      output="sigmoid")
+    assert not cfg.uses_pca_init() and not cfg.resolved_early_stopping()  # a sigmoid network starts at random
+    res = train_vae(X[:40], config=cfg, val_features=X[40:])
+    h = res.history
+    assert len(h) == 60 and res.model.output == "sigmoid" and res.model.sigma_floor == 0.0
+    # the cross-entropy cannot fall below the targets' entropy (~34 here): it falls slowly (Sec. 5.1), the MSE clearly
+    assert h[-1]["reconstruction"] < h[30]["reconstruction"] < h[0]["reconstruction"] and h[-1]["total"] < h[0]["total"]
+    assert h[-1]["mse"] < 0.7 * h[0]["mse"]
+    for r in h:
+        assert r["total"] == pytest.approx(r["reconstruction"] + r["kl"], rel=1e-5)
+    assert h[-1]["val_mse"] < h[0]["mse"]
+    again = train_vae(X[:40], config=cfg, val_features=X[40:])  # seeded like the MSE runs
+    assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), again.model.state_dict().values()))
+    with torch.no_grad():
+        out = res.model.decode(torch.zeros(3, 6))
+    assert torch.all((out > 0) & (out < 1))
+
+
+def test_network_options_come_from_the_config_and_are_checked():
+    X = _data(n=20, k=30)
+    res = train_vae(X, config=TrainConfig(epochs=2, progress=False, sigma_floor=1e-3, init="random"))
+    assert res.model.sigma_floor == 1e-3 and res.model.output == "tanh"
+    assert TrainConfig(sigma_floor=1e-3).uses_pca_init()  # the floor keeps the PCA start (tanh output)
+    assert pca_network(torch.from_numpy(X.astype(np.float32)), TrainConfig(sigma_floor=1e-3)).sigma_floor == 1e-3
+    for bad in (dict(loss="bce"), dict(loss="l1"), dict(output="relu"), dict(sigma_floor=-1.0)):
+        with pytest.raises(ValueError):
+            TrainConfig(**bad)
+    with pytest.raises(ValueError, match="output"):
+        train_vae(X, config=TrainConfig(epochs=1, progress=False), model=MeshVAE(30, 4, output="sigmoid"))

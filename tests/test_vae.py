@@ -166,3 +166,30 @@ def test_kl_stays_finite_when_the_deviation_head_saturates():
     assert torch.isfinite(parts["total"])
     parts["total"].backward()
     assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
+
+
+def test_sigma_floor_and_sigmoid_output_are_options_of_the_network():
+    torch.manual_seed(0)
+    plain = MeshVAE(12, 3, hidden=(5,))
+    torch.manual_seed(0)
+    other = MeshVAE(12, 3, hidden=(5,), sigma_floor=1e-3, output="sigmoid")
+    # no new parameters and the same creation order: the same seed gives the same weights
+    assert list(plain.state_dict()) == list(other.state_dict())
+    assert all(torch.equal(a, b) for a, b in zip(plain.state_dict().values(), other.state_dict().values()))
+    assert plain.config()["sigma_floor"] == 0.0 and plain.config()["output"] == "tanh"
+    assert MeshVAE(**other.config()).config() == other.config()
+    plain.eval(), other.eval()
+    x = torch.rand(4, 12) * 1.8 - 0.9
+    (mu_a, s_a), (mu_b, s_b) = plain.encode(x), other.encode(x)
+    assert torch.equal(mu_a, mu_b) and torch.equal(s_b, s_a + 1e-3)
+    _, s_sat = other.encode(torch.full((2, 12), -1e4))
+    assert torch.all(s_sat >= 1e-3)
+    z = torch.randn(4, 3)
+    h = plain.decoder_body(z)
+    assert torch.equal(plain.decode(z), torch.tanh(plain.decoder_head(h)))
+    assert torch.equal(other.decode(z), torch.sigmoid(other.decoder_head(h)))
+    for bad in (dict(output="relu"), dict(sigma_floor=-1.0), dict(sigma_floor=float("nan"))):
+        with pytest.raises(ValueError):
+            MeshVAE(12, 3, **bad)
+    with pytest.raises(ValueError, match="loss"):
+        vae_loss(x, x, mu_a, s_a, loss="l1")

@@ -49,7 +49,7 @@ class CourseModelSpec:
     name : registry key; lesson : the notebook that uses it; collection : a ``data_synth`` name;
     resolution : template vertices (approximate); data_seed : the collection's seed;
     features, labels, layout, holdout_every : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`'s
-    arguments; config : :class:`~meshvae_lib.model.training.TrainConfig` keywords (the budget: ``epochs``,
+    arguments; config : :class:`~meshvae_lib.model.train_config.TrainConfig` keywords (the budget: ``epochs``,
     ``latent_dim``, ...; ``progress`` is set by :func:`course_model`); minutes : the measured build
     time on 2 CPU cores, for the message shown before a build; description : one line.
     """
@@ -68,8 +68,8 @@ class CourseModelSpec:
     config: dict = field(default_factory=dict)
 
     def train_config(self, progress: bool = False):
-        """The :class:`~meshvae_lib.model.training.TrainConfig` this model is trained with."""
-        from meshvae_lib.model.training import TrainConfig
+        """The :class:`~meshvae_lib.model.train_config.TrainConfig` this model is trained with."""
+        from meshvae_lib.model.train_config import TrainConfig
 
         return TrainConfig(**{"device": "cpu", **self.config, "progress": progress})
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import re
 import zipfile
 from pathlib import Path
 
@@ -20,7 +21,7 @@ import torch
 from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.model.training import TrainConfig
+from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.vae import MeshVAE
 
 __all__ = ["load_model", "write_checkpoint", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
@@ -29,8 +30,9 @@ logger = logging.getLogger(__name__)
 
 #: value of the ``format`` entry of every checkpoint.
 CHECKPOINT_FORMAT = "meshvae-checkpoint"
-#: bumped when the layout of the checkpoint changes.
-CHECKPOINT_VERSION = 1
+#: bumped when the layout of the checkpoint changes (2: the network config has ``sigma_floor`` and ``output``;
+#: version 1 files load with their defaults, 0 and "tanh").
+CHECKPOINT_VERSION = 2
 
 
 def _to_storable(obj):
@@ -110,6 +112,23 @@ def write_checkpoint(path, model: MeshVAEModel) -> Path:
 _ZIP_MAGIC = b"PK\x03\x04"
 
 
+def _load_error_reason(exc: BaseException) -> str:
+    """What went wrong in torch.load, in a few words and without torch's advice to load with
+    ``weights_only=False`` (which would run whatever code a damaged or foreign file holds)."""
+    text = str(exc)
+    if "WeightsUnpickler error:" in text:
+        text = text.split("WeightsUnpickler error:", 1)[1]
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    first = lines[0] if lines else ""
+    match = re.match(r"Unsupported global: GLOBAL ([\w.]+)", first)
+    if match:
+        return f"an object of type {match.group(1)}"
+    first = first.split(". Please use")[0].split(" Check the documentation")[0]
+    if not first or re.search(r"weights.only", first, re.IGNORECASE):
+        return type(exc).__name__
+    return f"{type(exc).__name__}: {first}"
+
+
 def load_model(path, collection=None) -> MeshVAEModel:
     """Read a checkpoint written by ``model.save(path)``.
 
@@ -132,13 +151,12 @@ def load_model(path, collection=None) -> MeshVAEModel:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except (RuntimeError, EOFError, OSError, ValueError, zipfile.BadZipFile, KeyError, IndexError,
             AttributeError, TypeError, UnicodeDecodeError, ImportError) as exc:
-        raise ValueError(f"{path} is not a readable mesh VAE checkpoint (corrupted, truncated or another"
-                         f" kind of file): {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}") from exc
-    except Exception as exc:  # the unpickler raises its own error types for foreign pickles
+        raise ValueError(f"{path} is damaged (corrupted or truncated) or not a mesh VAE checkpoint: its"
+                         f" archive cannot be read ({_load_error_reason(exc)})") from exc
+    except Exception as exc:  # the unpickler raises its own error types for damaged or foreign pickles
         if type(exc).__module__.startswith(("pickle", "_pickle")) or "Unpickl" in type(exc).__name__:
-            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise ValueError(f"{path} is not a mesh VAE checkpoint (it holds objects a checkpoint never"
-                             f" holds): {first}") from exc
+            raise ValueError(f"{path} is damaged or not a mesh VAE checkpoint: it holds data a checkpoint never"
+                             f" holds ({_load_error_reason(exc)})") from exc
         raise
     if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
         raise ValueError(f"{path} is not a mesh VAE checkpoint (no '{CHECKPOINT_FORMAT}' marker)")

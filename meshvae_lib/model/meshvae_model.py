@@ -20,10 +20,18 @@ import torch
 
 from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
 from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.model.training import TrainConfig, holdout_mask, pad_sigma_object, train_vae
+from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.model.training import from_output_range, holdout_mask, pad_sigma_object, train_vae
 from meshvae_lib.tolerances import FIT_LATENT_STEP
 
 __all__ = ["MeshVAEModel"]
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A view of ``a`` that cannot be written through (the model's own array stays writable)."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 class MeshVAEModel:
@@ -32,7 +40,7 @@ class MeshVAEModel:
     Parameters
     ----------
     features : "rimd" | "aligned" | "coords" (the paper's Table 2; "rimd" is the mesh VAE proper).
-    config : :class:`~meshvae_lib.model.training.TrainConfig` (defaults when None).
+    config : :class:`~meshvae_lib.model.train_config.TrainConfig` (defaults when None).
     labels : label columns to condition on (conditional mesh VAE, Eq. 5); empty: unconditional.
     holdout_every : hold out every k-th mesh (k >= 2) from training to measure generalisation;
         0 trains on everything.
@@ -70,15 +78,12 @@ class MeshVAEModel:
         self.reference_index = reference_index
 
     # -- training ------------------------------------------------------------------------------
-    def fit(self, collection, network=None) -> "MeshVAEModel":
+    def fit(self, collection) -> "MeshVAEModel":
         """Extract features, normalise them, train the network.
 
         collection : a MeshCollection / SynthCollection (``vertices (N, n, 3)``, ``faces (F, 3)``,
-        ``labels``).
-        network : callable, optional
-            ``network(n_features, latent_dim, hidden, n_conditions) -> MeshVAE`` (a subclass, e.g.
-            with another output layer or prior); built with the config's seed. Default: ``MeshVAE``
-            as :func:`~meshvae_lib.model.training.train_vae` builds it.
+        ``labels``). The network is the one :func:`~meshvae_lib.model.training.train_vae` builds
+        from the config (its ``sigma_floor``, ``output`` and ``loss`` included).
 
         Returns ``self``.
         """
@@ -93,7 +98,7 @@ class MeshVAEModel:
         self.extractor_ = FeatureExtractor(self.features, self.layout, self.reference_index)
         self.extractor_.fit(V, collection.faces)
         X = self.extractor_.transform(V)
-        pca = network is None and config.uses_pca_init(len(self.labels))
+        pca = config.uses_pca_init(len(self.labels))
         self.normalizer_ = FeatureNormalizer(a=config.resolved_feature_range(pca),
                                              scale=config.resolved_feature_scale(self.features, pca)).fit(X[~mask])
         Xn = self.normalizer_.transform(X)
@@ -102,16 +107,10 @@ class MeshVAEModel:
             raise ValueError(f"no label column(s) {missing}; the data has {sorted(labels)}")
         self.conditions_ = ConditionEncoder(self.labels).fit({c: np.asarray(labels[c])[~mask] for c in self.labels})
         C = self.conditions_.transform(labels) if self.labels else None
-        net = None
-        if network is not None:
-            with torch.random.fork_rng(devices=[]):
-                torch.manual_seed(config.seed)
-                net = network(Xn.shape[1], config.latent_dim, config.hidden, 0 if C is None else C.shape[1])
         result = train_vae(
             Xn[~mask], None if C is None else C[~mask], config,
             val_features=Xn[mask] if mask.any() else None,
             val_conditions=None if C is None or not mask.any() else C[mask],
-            model=net,
         )
         self.network_ = result.model
         self.history_ = result.history
@@ -204,7 +203,9 @@ class MeshVAEModel:
             raise ValueError(f"latent vectors must have shape (N, {self.network_.latent_dim}), got {z.shape}")
         rows = self.network_.eval().decode(torch.from_numpy(np.ascontiguousarray(z2)),
                                            self._conditions(len(z2), conditions, labels))
-        V = self.extractor_.inverse_transform(self.normalizer_.inverse_transform(rows.double().numpy()))
+        # a sigmoid output decodes to BCE_TARGET_RANGE: back to Eq. 3's [-a, a] (tanh: unchanged)
+        rows = from_output_range(rows.double().numpy(), self.normalizer_.a, self.network_.output)
+        V = self.extractor_.inverse_transform(self.normalizer_.inverse_transform(rows))
         return V[0] if single else V
 
     def reconstruct(self, vertices, conditions=None, labels=None, fit_iterations: int = 0) -> np.ndarray:
@@ -322,17 +323,13 @@ class MeshVAEModel:
     def reference_vertices(self) -> np.ndarray:
         """The reference mesh the features are relative to: (n_vertices, 3) float64, read-only."""
         self._check_fitted()
-        V = self.extractor_.reference_.view()
-        V.flags.writeable = False
-        return V
+        return _read_only(self.extractor_.reference_)
 
     @property
     def faces(self) -> np.ndarray:
         """The model's triangles: (n_faces, 3) int64, read-only."""
         self._check_fitted()
-        F = self.extractor_.faces_.view()
-        F.flags.writeable = False
-        return F
+        return _read_only(self.extractor_.faces_)
 
     def check_compatible(self, collection) -> None:
         """ValueError unless ``collection`` has this model's mesh (and its label columns)."""

@@ -2,8 +2,10 @@
 
 :func:`train_vae` trains a :class:`~meshvae_lib.model.vae.MeshVAE` on rows of *normalised* features
 (Eq. 3) with Adam (lr 1e-3, the fused implementation: about 4x faster on a CPU than the default)
-and the loss of Eq. 4. Everything random (initial weights, shuffling, the reparameterisation noise)
-comes from ``config.seed``: the same seed gives bit-identical weights on a CPU.
+and the loss of Eq. 4 (or, with ``TrainConfig(loss="bce", output="sigmoid")``, the binary
+cross-entropy that Sec. 5.1 compares it with: the same batching and optimiser). Everything random
+(initial weights, shuffling, the reparameterisation noise) comes from ``config.seed``: the same
+seed gives bit-identical weights on a CPU.
 
 The higher-level entry point, from a mesh collection to a model that decodes meshes, is
 :meth:`meshvae_lib.model.meshvae_model.MeshVAEModel.fit`.
@@ -13,158 +15,25 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 
 from meshvae_lib.tolerances import PCA_INIT_RTOL
-from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, NORMALIZE_A, PCA_FEATURE_RANGE, VALIDATION_EVERY
-from meshvae_lib.model.vae import PRIOR_FORMS, MeshVAE, start_step, vae_loss
+from meshvae_lib.defaults import BCE_TARGET_RANGE
+from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
 
-__all__ = ["default_hidden", "TrainConfig", "TrainResult", "train_vae", "holdout_mask", "resolve_device",
-           "pad_sigma_object", "pca_network", "INIT_MODES"]
-
-#: how :func:`train_vae` initialises a new network.
-from meshvae_lib.defaults import DEFAULT_INIT, INIT_MODES  # noqa: E402  (re-exported)
+__all__ = ["TrainResult", "TrainingDiverged", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object", "pca_network",
+           "to_output_range", "from_output_range"]
 
 logger = logging.getLogger(__name__)
 
 
-def default_hidden(kind: str = "rimd", init: str = "pca") -> tuple[int, ...]:
-    """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
-
-    With the paper's random initialisation: none for RIMD, HIDDEN_COORDS for the coordinate
-    baselines. With the PCA initialisation (``init="pca"``, see ``TrainConfig.init``): none for
-    every kind, since a network without internal layers then starts at the linear floor, and on the
-    real collections nothing trained from a random start came near it (docs/vae.md, issue 12).
-    """
-    if init not in INIT_MODES:
-        raise ValueError(f"unknown init {init!r}; expected one of {INIT_MODES}")
-    if kind not in ("rimd", "coords", "aligned"):
-        raise ValueError(f"unknown feature kind {kind!r}")
-    if kind == "rimd" or init == "pca":
-        return ()
-    return tuple(HIDDEN_COORDS)
-
-
-@dataclass
-class TrainConfig:
-    """Training settings. The defaults train a good model for collections of 50-200 meshes.
-
-    epochs : passes over the training set.
-    batch_size : meshes per Adam step (the last batch is merged so that none has a single mesh,
-        which batch norm cannot handle).
-    lr : Adam learning rate (paper: 1e-3).
-    alpha : weight of the reconstruction term (Eq. 4; paper: 1e6).
-    latent_dim : D (paper: 128).
-    hidden : internal layer sizes, outermost first (default: none).
-    sigma_object : prior deviations (length D) or None for N(0, I) (Sec. 4.4). Shorter vectors are
-        padded with 1 by :func:`pad_sigma_object`.
-    prior_form : how sigma_object enters the latent cost, "exact" (the KL to N(0, diag
-        sigma_object^2)) or "sibling" (the authors' sibling-code formula, which makes the chosen
-        dimensions carry the dominant variation; see :func:`~meshvae_lib.model.vae.kl_divergence`).
-    seed : seeds initial weights, shuffling and sampling.
-    device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
-    progress : show a tqdm progress bar (terminal or notebook).
-    eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
-        how often early stopping looks at its validation meshes.
-    init : "pca" (default) or "random" (PyTorch's initialisation: the paper's training; with
-        ``early_stopping=False`` all ``epochs`` are trained, as the paper does). The PCA start is
-        the library's departure from the paper: on real meshes the paper's training generalised
-        2-6x worse than PCA of the coordinates (docs/vae.md, "Generalisation on real meshes").
-        "pca": an unconditional network without internal layers
-        and with the standard prior (``hidden=()``, ``sigma_object=None``) is built by
-        :func:`pca_network`:
-        its encoder sees the whitened principal coefficients of the training features and its
-        decoder starts as the PCA reconstruction, so training starts at the linear floor. Other
-        networks (internal layers, a sigma_object prior) and ``"random"`` use PyTorch's random
-        initialisation on the K features (the paper's network); so do conditional networks, whose
-        use of the condition has to be learned.
-    feature_range : half-width a of the normalised range (Eq. 3) that
-        :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
-        PCA-initialised networks, the paper's 0.9 otherwise.
-    early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
-        there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
-        row is set aside, a network is trained on the others and evaluated on them (feature MSE,
-        encoded to the mean) before training and every ``eval_every`` epochs, until ``patience``
-        epochs bring no improvement; then a new network is trained on *all* rows for the best
-        number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
-    validation_every, patience : see ``early_stopping``.
-    feature_scale : "component" (the paper's Eq. 3) or "shared" (one half-width for all components,
-        see :class:`~meshvae_lib.model.normalization.FeatureNormalizer`). None: "shared" for coordinate
-        features (``"coords"``, ``"aligned"``) of PCA-initialised networks, "component" otherwise.
-    """
-
-    epochs: int = DEFAULT_EPOCHS
-    batch_size: int = DEFAULT_BATCH_SIZE
-    lr: float = DEFAULT_LR
-    alpha: float = DEFAULT_ALPHA
-    latent_dim: int = DEFAULT_LATENT
-    hidden: tuple[int, ...] = ()
-    sigma_object: tuple[float, ...] | None = None
-    prior_form: str = "exact"
-    seed: int = 0
-    device: str = "auto"
-    progress: bool = True
-    eval_every: int = 10
-    init: str = DEFAULT_INIT
-    feature_range: float | None = None
-    early_stopping: bool | None = None
-    validation_every: int = VALIDATION_EVERY
-    patience: int = EARLY_STOPPING_PATIENCE
-    feature_scale: str | None = None
-
-    def uses_pca_init(self, n_conditions: int = 0) -> bool:
-        """True when a new network is built by :func:`pca_network` (see ``init``)."""
-        return self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
-
-    def resolved_feature_range(self, pca: bool | None = None) -> float:
-        """a of Eq. 3 for this config (``pca``: whether the PCA initialisation applies; None: ask)."""
-        if self.feature_range is not None:
-            return float(self.feature_range)
-        pca = self.uses_pca_init() if pca is None else pca
-        return PCA_FEATURE_RANGE if pca else NORMALIZE_A
-
-    def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
-        """How :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
-        if self.feature_scale is not None:
-            return self.feature_scale
-        pca = self.uses_pca_init() if pca is None else pca
-        return "shared" if pca and kind in ("coords", "aligned") else "component"
-
-    def resolved_early_stopping(self, pca: bool | None = None) -> bool:
-        if self.early_stopping is not None:
-            return bool(self.early_stopping)
-        return self.uses_pca_init() if pca is None else bool(pca)
-
-    def __post_init__(self):
-        self.hidden = tuple(int(h) for h in self.hidden)
-        if self.sigma_object is not None:
-            self.sigma_object = tuple(float(s) for s in self.sigma_object)
-        checks = {
-            "epochs": self.epochs >= 1,
-            "batch_size": self.batch_size >= 2,
-            "lr": self.lr > 0,
-            "alpha": self.alpha > 0,
-            "latent_dim": self.latent_dim >= 1,
-            "eval_every": self.eval_every >= 1,
-            "prior_form": self.prior_form in PRIOR_FORMS,
-            "init": self.init in INIT_MODES,
-            "feature_range": self.feature_range is None or 0.0 < float(self.feature_range) < 1.0,
-            "validation_every": self.validation_every >= 2,
-            "patience": self.patience >= 1,
-            "feature_scale": self.feature_scale in (None, "component", "shared"),
-        }
-        for name, ok in checks.items():
-            if not ok:
-                raise ValueError(f"TrainConfig.{name} is out of range: {getattr(self, name)!r}")
-
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d["hidden"] = list(self.hidden)
-        d["sigma_object"] = None if self.sigma_object is None else list(self.sigma_object)
-        return d
+class TrainingDiverged(ValueError):
+    """Training produced a non-finite loss (a ValueError: the settings, e.g. the learning rate, were
+    too large for the data; the command line reports it as a failure on valid input)."""
 
 
 @dataclass
@@ -235,16 +104,54 @@ def _as_tensor(x, name: str, rows: int | None = None) -> torch.Tensor:
     return torch.from_numpy(np.ascontiguousarray(a))
 
 
+def to_output_range(x, a: float, output: str = "sigmoid"):
+    """Rows normalised to [-a, a] (Eq. 3) -> what a network with ``output`` reproduces: the rows
+    themselves for "tanh", for "sigmoid" the affine map onto ``BCE_TARGET_RANGE`` ([0.1, 0.9]).
+    numpy arrays or tensors."""
+    if output == "tanh":
+        return x
+    lo, hi = BCE_TARGET_RANGE
+    return lo + (x + a) * (hi - lo) / (2 * a)
+
+
+def from_output_range(p, a: float, output: str = "sigmoid"):
+    """The inverse of :func:`to_output_range`: a network's decoded rows -> rows in [-a, a]."""
+    if output == "tanh":
+        return p
+    lo, hi = BCE_TARGET_RANGE
+    return (p - lo) * (2 * a) / (hi - lo) - a
+
+
+def _mse_scale(model, config) -> float | None:
+    """Factor from the network's output units to Eq. 3's for the logged MSE (None: the same)."""
+    if model.output == "tanh":
+        return None
+    lo, hi = BCE_TARGET_RANGE
+    return (2 * config.resolved_feature_range(False) / (hi - lo)) ** 2
+
+
+def _targets(model, x, config):
+    """The rows the network's output is compared with (``x`` itself for a tanh output)."""
+    return to_output_range(x, config.resolved_feature_range(False), model.output)
+
+
+def _loss(x_hat, y, mu, sigma, config, so_t, mse_scale) -> dict:
+    parts = vae_loss(x_hat, y, mu, sigma, config.alpha, so_t, config.prior_form, config.loss)
+    if mse_scale is not None:
+        parts["mse"] = parts["mse"] * mse_scale
+    return parts
+
+
 def _batches(n: int, batch_size: int, perm: torch.Tensor) -> list[torch.Tensor]:
     n_batches = max(1, n // batch_size)  # the remainder joins the other batches: none of size 1
     return list(torch.tensor_split(perm, n_batches))
 
 
 @torch.no_grad()
-def _evaluate(model, x, c, alpha, sigma_object, prior_form) -> dict:
+def _evaluate(model, x, c, config, so_t) -> dict:
     model.eval()
     mu, sigma = model.encode(x, c)
-    parts = vae_loss(model.decode(mu, c), x, mu, sigma, alpha, sigma_object, prior_form)
+    parts = _loss(model.decode(mu, c), _targets(model, x, config), mu, sigma, config, so_t, _mse_scale(model, config))
     return {f"val_{k}": float(v) for k, v in parts.items()}
 
 
@@ -269,6 +176,8 @@ def pca_network(x: torch.Tensor, config: "TrainConfig", n_conditions: int = 0) -
     """
     if config.hidden:
         raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
+    if config.output != "tanh":
+        raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
     X = x.detach().double().cpu().numpy()
     n, k = X.shape
     mean = X.mean(axis=0)
@@ -287,7 +196,7 @@ def pca_network(x: torch.Tensor, config: "TrainConfig", n_conditions: int = 0) -
     A = np.arctanh(np.clip(X, -1 + 1e-6, 1 - 1e-6))
     sol, *_ = np.linalg.lstsq(np.c_[Z, np.ones(n)], A, rcond=None)  # (r + 1, K)
     D = config.latent_dim
-    net = MeshVAE(k, D, (), n_conditions, input_rank=r)
+    net = MeshVAE(k, D, (), n_conditions, input_rank=r, sigma_floor=config.sigma_floor)
     sigma = 1.0 / np.sqrt(1.0 + config.alpha * c ** 2 / k)
     sigma_logit = np.log(sigma / (net.sigma_max - sigma))
     f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
@@ -310,7 +219,8 @@ def _new_network(x, n_cond, config, pca: bool) -> MeshVAE:
         torch.manual_seed(config.seed)
         if pca:
             return pca_network(x, config, n_cond)
-        return MeshVAE(x.shape[1], config.latent_dim, config.hidden, n_cond)
+        return MeshVAE(x.shape[1], config.latent_dim, config.hidden, n_cond, sigma_floor=config.sigma_floor,
+                       output=config.output)
 
 
 def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, select=False, desc="training mesh VAE"):
@@ -329,8 +239,9 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
 
     history: list[dict] = []
     best_epoch, best_val = 0, np.inf
+    y, scale = _targets(model, x, config), _mse_scale(model, config)
     if select:
-        best_val = _evaluate(model, xv, cv, config.alpha, so_t, config.prior_form)["val_mse"]
+        best_val = _evaluate(model, xv, cv, config, so_t)["val_mse"]
         history.append({"epoch": 0, "val_mse": best_val})
     bar = tqdm(range(epochs), desc=desc, unit="epoch", disable=not config.progress)
     for epoch in bar:
@@ -342,7 +253,7 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
             xb = x[idx]
             cb = None if c is None else c[idx]
             x_hat, mu, sigma = model(xb, cb, generator=noise_gen)
-            parts = vae_loss(x_hat, xb, mu, sigma, config.alpha, so_t, config.prior_form)
+            parts = _loss(x_hat, xb if y is x else y[idx], mu, sigma, config, so_t, scale)
             start_step(model)  # zero the gradients, keeping the big buffers (see vae.Linear)
             parts["total"].backward()
             optimizer.step()
@@ -351,12 +262,12 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
                 sums[key] += w * float(parts[key].detach())
         if not np.isfinite(sums["total"]):
             bar.close()
-            raise ValueError(f"training diverged at epoch {epoch + 1} (loss {sums['total']}); try a smaller"
+            raise TrainingDiverged(f"training diverged at epoch {epoch + 1} (loss {sums['total']}); try a smaller"
                              f" learning rate (now {config.lr:g}) or alpha (now {config.alpha:g})")
         last = epoch + 1 == epochs
         if select:
             if (epoch + 1) % config.eval_every == 0 or last:
-                val = _evaluate(model, xv, cv, config.alpha, so_t, config.prior_form)["val_mse"]
+                val = _evaluate(model, xv, cv, config, so_t)["val_mse"]
                 history.append({"epoch": epoch + 1, "mse": sums["mse"], "val_mse": val})
                 if val < best_val:
                     best_epoch, best_val = epoch + 1, val
@@ -365,7 +276,7 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
             continue
         record = {"epoch": epoch + 1, **sums}
         if xv is not None and ((epoch + 1) % config.eval_every == 0 or last):
-            record.update(_evaluate(model, xv, cv, config.alpha, so_t, config.prior_form))
+            record.update(_evaluate(model, xv, cv, config, so_t))
         history.append(record)
         logger.debug("epoch %d: %s", epoch + 1, record)
         if config.progress:
@@ -428,6 +339,9 @@ def train_vae(
                 f"the given model expects {model.n_features} features and {model.n_conditions} conditions,"
                 f" got {k} and {n_cond}"
             )
+        if (model.output, model.sigma_floor) != (config.output, float(config.sigma_floor)):
+            raise ValueError(f"the given model has output={model.output!r}, sigma_floor={model.sigma_floor:g};"
+                             f" the config asks for output={config.output!r}, sigma_floor={config.sigma_floor:g}")
     early = model is None and config.resolved_early_stopping(pca) and n >= 2 * config.validation_every
     latent = model.latent_dim if model is not None else config.latent_dim
     so = pad_sigma_object(config.sigma_object, latent)
@@ -458,10 +372,9 @@ def train_vae(
         cv = None if cv is None else cv.to(device)
     history, _ = _run(model, x, c, config, epochs, device, xv, cv, so_t)
     if not history:  # not trained at all: record the starting point
-        record = {"epoch": 0, **{k_[4:]: v for k_, v in _evaluate(model, x, c, config.alpha, so_t,
-                                                                    config.prior_form).items()}}
+        record = {"epoch": 0, **{k_[4:]: v for k_, v in _evaluate(model, x, c, config, so_t).items()}}
         if xv is not None:
-            record.update(_evaluate(model, xv, cv, config.alpha, so_t, config.prior_form))
+            record.update(_evaluate(model, xv, cv, config, so_t))
         history.append(record)
     seconds = time.perf_counter() - t0
     logger.info("trained %d epochs in %.1f s on %s; final %s", epochs, seconds, device, history[-1])

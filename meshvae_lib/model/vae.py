@@ -2,10 +2,12 @@
 
 Architecture (Sec. 4.2, "Network structure"): a fully connected encoder and decoder. Every
 *internal* layer is ``Linear -> BatchNorm1d -> LeakyReLU``. The encoder ends in two heads, the mean
-``mu`` (no activation) and the deviation ``sigma = sigma_max * sigmoid(.)`` (sigma_max = 2, so that
-sigma can cover the prior's 1). The decoder ends in ``tanh``, matching features normalised to
-[-a, a] (Eq. 3). With ``hidden=()`` (the default) the encoder is one linear map K -> 2D and the
-decoder one linear map D -> K, so there are no internal layers.
+``mu`` (no activation) and the deviation ``sigma = sigma_max * sigmoid(.) + sigma_floor`` (sigma_max =
+2, so that sigma can cover the prior's 1; ``sigma_floor`` = 0 by default). The decoder ends in
+``tanh``, matching features normalised to [-a, a] (Eq. 3), or, with ``output="sigmoid"``, in a
+sigmoid (the cross-entropy model of Sec. 5.1, trained on rows mapped to ``BCE_TARGET_RANGE``). With
+``hidden=()`` (the default) the encoder is one linear map K -> 2D and the decoder one linear map
+D -> K, so there are no internal layers.
 
 Input projection (``input_rank = r > 0``, a departure from the paper, issue 12): the encoder does
 not see the K features themselves but their r whitened principal coefficients
@@ -39,9 +41,9 @@ import torch
 from torch import nn
 
 from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
-from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, OUTPUTS, PRIOR_FORMS, SIGMA_MAX
 
-__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear", "PRIOR_FORMS"]
+__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear"]
 
 
 class _LinearGradInPlace(torch.autograd.Function):
@@ -130,6 +132,12 @@ class MeshVAE(nn.Module):
     input_rank : int
         r > 0: the encoder sees r fixed principal coefficients of its input (buffers
         ``input_mean (K,)`` and ``input_basis (r, K)``, zeros until set); 0: the K features.
+    sigma_floor : float
+        added to the deviation output, so that sigma >= sigma_floor (default 0: none; the paper's
+        experiments use ``tolerances.SIGMA_FLOOR``).
+    output : "tanh" | "sigmoid"
+        the decoder's last activation: tanh (the paper, features in [-a, a]) or sigmoid (outputs in
+        (0, 1), for the binary cross-entropy loss).
     """
 
     def __init__(
@@ -141,6 +149,8 @@ class MeshVAE(nn.Module):
         sigma_max: float = SIGMA_MAX,
         negative_slope: float = LEAKY_RELU_SLOPE,
         input_rank: int = 0,
+        sigma_floor: float = 0.0,
+        output: str = "tanh",
     ):
         super().__init__()
         hidden = tuple(int(h) for h in hidden)
@@ -155,6 +165,10 @@ class MeshVAE(nn.Module):
             raise ValueError(f"hidden layer sizes must be positive, got {hidden}")
         if not sigma_max > 0:
             raise ValueError(f"sigma_max must be positive, got {sigma_max}")
+        if not 0.0 <= float(sigma_floor) < float("inf"):
+            raise ValueError(f"sigma_floor must be finite and >= 0, got {sigma_floor}")
+        if output not in OUTPUTS:
+            raise ValueError(f"output must be one of {OUTPUTS}, got {output!r}")
         self.n_features = int(n_features)
         self.latent_dim = int(latent_dim)
         self.hidden = hidden
@@ -162,6 +176,8 @@ class MeshVAE(nn.Module):
         self.sigma_max = float(sigma_max)
         self.negative_slope = float(negative_slope)
         self.input_rank = int(input_rank)
+        self.sigma_floor = float(sigma_floor)
+        self.output = str(output)
         if self.input_rank:
             self.register_buffer("input_mean", torch.zeros(self.n_features))
             self.register_buffer("input_basis", torch.zeros(self.input_rank, self.n_features))
@@ -194,6 +210,8 @@ class MeshVAE(nn.Module):
             "sigma_max": self.sigma_max,
             "negative_slope": self.negative_slope,
             "input_rank": self.input_rank,
+            "sigma_floor": self.sigma_floor,
+            "output": self.output,
         }
 
     def _with_condition(self, x: torch.Tensor, c, width: int, what: str) -> torch.Tensor:
@@ -216,8 +234,9 @@ class MeshVAE(nn.Module):
         """Probabilistic encoder q(z | x, c).
 
         x : (B, K) float32 normalised features; c : (B, C) float32 or None.
-        Returns mu : (B, D) and sigma : (B, D) float32, 0 < sigma < sigma_max (the sigmoid's input
-        is floored at SIGMA_LOGIT_MIN = -30, so sigma >= 1.9e-13 and log sigma^2 stays finite).
+        Returns mu : (B, D) and sigma : (B, D) float32, sigma_floor < sigma < sigma_max + sigma_floor
+        (the sigmoid's input is floored at SIGMA_LOGIT_MIN = -30, so sigma >= 1.9e-13 even without
+        a floor and log sigma^2 stays finite).
         """
         if self.input_rank:
             if x.ndim != 2 or x.shape[1] != self.n_features:
@@ -230,7 +249,10 @@ class MeshVAE(nn.Module):
         mu, s = out[:, : self.latent_dim], out[:, self.latent_dim :]
         # With K ~ 1e4-1e5 inputs an Adam step can move s by ~10, and alpha = 1e6 pushes sigma to
         # 0: without a floor sigmoid underflows, log(sigma^2) = -inf and training turns to NaN.
-        return mu, self.sigma_max * torch.sigmoid(s.clamp(min=SIGMA_LOGIT_MIN))
+        sigma = self.sigma_max * torch.sigmoid(s.clamp(min=SIGMA_LOGIT_MIN))
+        if self.sigma_floor:
+            sigma = sigma + self.sigma_floor
+        return mu, sigma
 
     def reparameterize(
         self, mu: torch.Tensor, sigma: torch.Tensor, generator: torch.Generator | None = None
@@ -240,8 +262,11 @@ class MeshVAE(nn.Module):
         return mu + sigma * eps
 
     def decode(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
-        """Probabilistic decoder's mean: z (B, D) [+ c (B, C)] -> features (B, K) in (-1, 1)."""
+        """Probabilistic decoder's mean: z (B, D) [+ c (B, C)] -> features (B, K) in (-1, 1)
+        (``output="sigmoid"``: in (0, 1))."""
         h = self.decoder_body(self._with_condition(z, c, self.latent_dim, "latent vectors"))
+        if self.output == "sigmoid":
+            return torch.sigmoid(self.decoder_head(h))
         return torch.tanh(self.decoder_head(h))
 
     def forward(
@@ -252,8 +277,6 @@ class MeshVAE(nn.Module):
         z = self.reparameterize(mu, sigma, generator)
         return self.decode(z, c), mu, sigma
 
-
-from meshvae_lib.defaults import PRIOR_FORMS  # noqa: E402  (re-exported)
 
 
 def kl_divergence(
@@ -304,18 +327,28 @@ def vae_loss(
     alpha: float = DEFAULT_ALPHA,
     sigma_object: torch.Tensor | None = None,
     prior_form: str = "exact",
+    loss: str = "mse",
 ) -> dict[str, torch.Tensor]:
     """Mesh VAE loss (Eq. 4; Eq. 5 for the conditional model, whose prior does not depend on c).
 
     x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D); sigma_object and
-    prior_form : see :func:`kl_divergence`.
-    Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2,
-    ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise), and ``mse`` =
-    mean squared error per component (for logging; alpha-free).
+    prior_form : see :func:`kl_divergence`; loss : the reconstruction term, "mse" (the paper's) or
+    "bce" (binary cross-entropy of a sigmoid output against targets in [0, 1] -- others are clipped --,
+    summed over the K components and averaged over the meshes, as DRAW; alpha is not used; Sec. 5.1).
+    Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2 (or
+    the cross-entropy), ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise),
+    and ``mse`` = mean squared error per component (for logging; alpha-free).
     """
     if x_hat.shape != x.shape or x.ndim != 2:
         raise ValueError(f"x_hat and x must be (M, K) of the same shape, got {tuple(x_hat.shape)} and {tuple(x.shape)}")
-    mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
-    reconstruction = 0.5 * alpha * mse
+    if loss not in LOSSES:
+        raise ValueError(f"loss must be one of {LOSSES}, got {loss!r}")
+    if loss == "bce":
+        # targets beyond [0, 1] (held-out rows outside the training range) are clipped: BCE needs [0, 1]
+        reconstruction = torch.nn.functional.binary_cross_entropy(x_hat, x.clamp(0.0, 1.0), reduction="sum") / x.shape[0]
+        mse = torch.nn.functional.mse_loss(x_hat.detach(), x)
+    else:
+        mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
+        reconstruction = 0.5 * alpha * mse
     kl = torch.mean(kl_divergence(mu, sigma, sigma_object, prior_form))
     return {"total": reconstruction + kl, "reconstruction": reconstruction, "kl": kl, "mse": mse.detach()}

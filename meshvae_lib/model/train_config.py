@@ -1,0 +1,163 @@
+"""The training configuration of the mesh VAE (every option of :func:`~meshvae_lib.model.training.train_vae`)
+and the default network size per feature kind.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_INIT,
+                                  DEFAULT_LATENT, DEFAULT_LR, EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, INIT_MODES,
+                                  LOSSES, NORMALIZE_A, OUTPUTS, PCA_FEATURE_RANGE, PRIOR_FORMS, VALIDATION_EVERY)
+
+__all__ = ["TrainConfig", "default_hidden"]
+
+
+def default_hidden(kind: str = "rimd", init: str = "pca") -> tuple[int, ...]:
+    """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
+
+    With the paper's random initialisation: none for RIMD, HIDDEN_COORDS for the coordinate
+    baselines. With the PCA initialisation (``init="pca"``, see ``TrainConfig.init``): none for
+    every kind, since a network without internal layers then starts at the linear floor, and on the
+    real collections nothing trained from a random start came near it (docs/vae.md, issue 12).
+    """
+    if init not in INIT_MODES:
+        raise ValueError(f"unknown init {init!r}; expected one of {INIT_MODES}")
+    if kind not in ("rimd", "coords", "aligned"):
+        raise ValueError(f"unknown feature kind {kind!r}")
+    if kind == "rimd" or init == "pca":
+        return ()
+    return tuple(HIDDEN_COORDS)
+
+
+@dataclass
+class TrainConfig:
+    """Training settings. The defaults train a good model for collections of 50-200 meshes.
+
+    epochs : passes over the training set.
+    batch_size : meshes per Adam step (the last batch is merged so that none has a single mesh,
+        which batch norm cannot handle).
+    lr : Adam learning rate (paper: 1e-3).
+    alpha : weight of the reconstruction term (Eq. 4; paper: 1e6).
+    latent_dim : D (paper: 128).
+    hidden : internal layer sizes, outermost first (default: none).
+    sigma_object : prior deviations (length D) or None for N(0, I) (Sec. 4.4). Shorter vectors are
+        padded with 1 by :func:`pad_sigma_object`.
+    prior_form : how sigma_object enters the latent cost, "exact" (the KL to N(0, diag
+        sigma_object^2)) or "sibling" (the authors' sibling-code formula, which makes the chosen
+        dimensions carry the dominant variation; see :func:`~meshvae_lib.model.vae.kl_divergence`).
+    seed : seeds initial weights, shuffling and sampling.
+    device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
+    progress : show a tqdm progress bar (terminal or notebook).
+    eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
+        how often early stopping looks at its validation meshes.
+    init : "pca" (default) or "random" (PyTorch's initialisation: the paper's training; with
+        ``early_stopping=False`` all ``epochs`` are trained, as the paper does). The PCA start is
+        the library's departure from the paper: on real meshes the paper's training generalised
+        2-6x worse than PCA of the coordinates (docs/vae.md, "Generalisation on real meshes").
+        "pca": an unconditional network without internal layers
+        and with the standard prior (``hidden=()``, ``sigma_object=None``) is built by
+        :func:`pca_network`:
+        its encoder sees the whitened principal coefficients of the training features and its
+        decoder starts as the PCA reconstruction, so training starts at the linear floor. Other
+        networks (internal layers, a sigma_object prior) and ``"random"`` use PyTorch's random
+        initialisation on the K features (the paper's network); so do conditional networks, whose
+        use of the condition has to be learned.
+    feature_range : half-width a of the normalised range (Eq. 3) that
+        :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
+        PCA-initialised networks, the paper's 0.9 otherwise.
+    early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
+        there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
+        row is set aside, a network is trained on the others and evaluated on them (feature MSE,
+        encoded to the mean) before training and every ``eval_every`` epochs, until ``patience``
+        epochs bring no improvement; then a new network is trained on *all* rows for the best
+        number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
+    validation_every, patience : see ``early_stopping``.
+    feature_scale : "component" (the paper's Eq. 3) or "shared" (one half-width for all components,
+        see :class:`~meshvae_lib.model.normalization.FeatureNormalizer`). None: "shared" for coordinate
+        features (``"coords"``, ``"aligned"``) of PCA-initialised networks, "component" otherwise.
+    sigma_floor, output : the new network's options (see :class:`~meshvae_lib.model.vae.MeshVAE`):
+        a floor added to the deviation (default 0) and the decoder's last activation, "tanh"
+        (default) or "sigmoid". A sigmoid network is trained on the rows mapped to
+        ``BCE_TARGET_RANGE`` (:func:`to_output_range`) and is never PCA-initialised.
+    loss : the reconstruction term, "mse" (Eq. 4, default) or "bce" (binary cross-entropy, needs
+        ``output="sigmoid"``; see :func:`~meshvae_lib.model.vae.vae_loss`).
+    """
+
+    epochs: int = DEFAULT_EPOCHS
+    batch_size: int = DEFAULT_BATCH_SIZE
+    lr: float = DEFAULT_LR
+    alpha: float = DEFAULT_ALPHA
+    latent_dim: int = DEFAULT_LATENT
+    hidden: tuple[int, ...] = ()
+    sigma_object: tuple[float, ...] | None = None
+    prior_form: str = "exact"
+    seed: int = 0
+    device: str = "auto"
+    progress: bool = True
+    eval_every: int = 10
+    init: str = DEFAULT_INIT
+    feature_range: float | None = None
+    early_stopping: bool | None = None
+    validation_every: int = VALIDATION_EVERY
+    patience: int = EARLY_STOPPING_PATIENCE
+    feature_scale: str | None = None
+    sigma_floor: float = 0.0
+    output: str = "tanh"
+    loss: str = "mse"
+
+    def uses_pca_init(self, n_conditions: int = 0) -> bool:
+        """True when a new network is built by :func:`pca_network` (see ``init``)."""
+        return (self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
+                and self.output == "tanh")
+
+    def resolved_feature_range(self, pca: bool | None = None) -> float:
+        """a of Eq. 3 for this config (``pca``: whether the PCA initialisation applies; None: ask)."""
+        if self.feature_range is not None:
+            return float(self.feature_range)
+        pca = self.uses_pca_init() if pca is None else pca
+        return PCA_FEATURE_RANGE if pca else NORMALIZE_A
+
+    def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
+        """How :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
+        if self.feature_scale is not None:
+            return self.feature_scale
+        pca = self.uses_pca_init() if pca is None else pca
+        return "shared" if pca and kind in ("coords", "aligned") else "component"
+
+    def resolved_early_stopping(self, pca: bool | None = None) -> bool:
+        if self.early_stopping is not None:
+            return bool(self.early_stopping)
+        return self.uses_pca_init() if pca is None else bool(pca)
+
+    def __post_init__(self):
+        self.hidden = tuple(int(h) for h in self.hidden)
+        if self.sigma_object is not None:
+            self.sigma_object = tuple(float(s) for s in self.sigma_object)
+        self.sigma_floor = float(self.sigma_floor)
+        checks = {
+            "epochs": self.epochs >= 1,
+            "batch_size": self.batch_size >= 2,
+            "lr": self.lr > 0,
+            "alpha": self.alpha > 0,
+            "latent_dim": self.latent_dim >= 1,
+            "eval_every": self.eval_every >= 1,
+            "prior_form": self.prior_form in PRIOR_FORMS,
+            "init": self.init in INIT_MODES,
+            "feature_range": self.feature_range is None or 0.0 < float(self.feature_range) < 1.0,
+            "validation_every": self.validation_every >= 2,
+            "patience": self.patience >= 1,
+            "feature_scale": self.feature_scale in (None, "component", "shared"),
+            "sigma_floor": 0.0 <= float(self.sigma_floor) < float("inf"),
+            "output": self.output in OUTPUTS,
+            "loss": self.loss in LOSSES and (self.loss != "bce" or self.output == "sigmoid"),
+        }
+        for name, ok in checks.items():
+            if not ok:
+                raise ValueError(f"TrainConfig.{name} is out of range: {getattr(self, name)!r}")
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["hidden"] = list(self.hidden)
+        d["sigma_object"] = None if self.sigma_object is None else list(self.sigma_object)
+        return d

@@ -1,0 +1,54 @@
+"""Paper Table 2: held-out error with 3D coordinates, aligned coordinates and RIMD features."""
+
+from __future__ import annotations
+
+import logging
+from typing import Sequence
+
+from meshvae_lib.paper.protocol import (available, heldout_error, load_collection, name_of, registry_names, timed,
+                                        train_model)
+from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
+from meshvae_lib.paper.tables import ExperimentTable
+
+__all__ = ["feature_table"]
+
+logger = logging.getLogger(__name__)
+
+
+@timed
+def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "aligned", "rimd"),
+                  settings: ExperimentSettings | None = None, quick: bool = False,
+                  cache: dict | None = None) -> ExperimentTable:
+    """Paper Table 2: held-out error with 3D coordinates, aligned coordinates and RIMD features.
+
+    ``collections``: default every ``data_synth`` collection. The same network (and training
+    budget) is used for the three inputs. Returns one row per collection with our three errors,
+    the reductions of RIMD against each baseline, and the paper's numbers where it has the
+    collection.
+    """
+    s = resolve_settings(settings, quick)
+    if collections is None:
+        collections = registry_names()
+    cols = (["collection [N]"] + [f"ours {k}" for k in kinds] + ["RIMD vs coords", "RIMD vs aligned"]
+            + [f"paper {k}" for k in ("coords", "aligned", "rimd")])
+    table = ExperimentTable("table2_features", "Table 2: held-out per-vertex error by input feature", cols)
+    table.data["errors"] = {}
+    for entry in available(collections):
+        name = name_of(entry)
+        coll = load_collection(entry, s, cache=cache)
+        errs = {k: heldout_error(train_model(coll, s, cache, features=k), coll)["mean_vertex_error"] for k in kinds}
+        table.data["errors"][name] = errs
+        logger.info("table 2, %s [%d meshes]: %s", name, len(coll.vertices),
+                    ", ".join(f"{k} {v:.4e}" for k, v in errs.items()))
+        red_c = 1 - errs["rimd"] / errs["coords"] if "coords" in errs and "rimd" in errs else None
+        red_a = 1 - errs["rimd"] / errs["aligned"] if "aligned" in errs and "rimd" in errs else None
+        paper = PAPER["table2"].get(name)
+        pcells = [p * paper[1] for p in paper[2]] if paper else [None] * 3
+        table.rows.append([f"{name} [{len(coll.vertices)}]"] + [errs[k] for k in kinds]
+                          + [None if red_c is None else f"{100 * red_c:.0f}%",
+                             None if red_a is None else f"{100 * red_a:.0f}%"] + pcells)
+    table.data["kinds"] = list(kinds)
+    table.notes.append("Paper: RIMD reduces the error by 59-94% against 3D coordinates and 27-72% against aligned"
+                       " coordinates. Here the three inputs share the training budget; the coordinate baselines get"
+                       " the hidden layer that did best for them (training.default_hidden), RIMD none.")
+    return table
