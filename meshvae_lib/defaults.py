@@ -17,7 +17,7 @@ PRIOR_FORMS = ("exact", "sibling")
 OUTPUTS = ("tanh", "sigmoid")
 #: the reconstruction terms of ``vae.vae_loss`` (``loss=...``; "bce" needs the sigmoid output).
 LOSSES = ("mse", "bce")
-#: network initialisations (``training.TrainConfig.init``) and the default.
+#: network initialisations (``train_config.TrainConfig.init``) and the default.
 INIT_MODES = ("pca", "random")
 DEFAULT_INIT = "pca"
 #: reconstruction methods and rotation recovery (``reconstruction.RIMDReconstructor``).

@@ -96,6 +96,16 @@ def test_code_fingerprint_covers_the_model_layers_not_the_viewers():
         probe.unlink()
 
 
+def test_code_fingerprint_ignores_comments_and_docstrings_not_code():
+    src = '"""Doc."""\nX = 1  # a comment\n\ndef f(a):\n    """What f does."""\n    return a + X\n'
+    same = '"""Other doc."""\n# new comment\nX = 1\n\ndef f(a):\n    return a + X  # still the same code\n'
+    other = '"""Doc."""\nX = 2\n\ndef f(a):\n    """What f does."""\n    return a + X\n'
+    assert cm._code_without_docstrings(src) == cm._code_without_docstrings(same)
+    assert cm._code_without_docstrings(src) != cm._code_without_docstrings(other)
+    only_doc = 'def g():\n    """Only a docstring."""\n'
+    assert "Pass" in cm._code_without_docstrings(only_doc)   # still a valid tree
+
+
 def test_course_model_builds_once_then_loads(cache, monkeypatch):
     assert not cm.is_cached(TINY.name)
     first = cm.course_model(TINY.name, progress=False)

@@ -9,11 +9,12 @@ cache and returned.
 The cache lives in ``$MESHVAE_CACHE`` when set, else ``$XDG_CACHE_HOME/meshvae``, else
 ``~/.cache/meshvae`` (:func:`cache_dir`). An entry's file name holds its key (:func:`model_key`): a
 hash of everything that determines the model -- the specification, the full training
-configuration, the numpy and torch versions and the source code of the library layers that make
-the data and train the model. A change to any of them gives another key, so a stale entry is never
-loaded; it is removed when the new one is written. A damaged entry (a failed checksum, a truncated
-file) is logged, removed and rebuilt. Checkpoints are written atomically
-(:func:`~meshvae_lib.model.checkpoint.save_model`), so an interrupted build leaves no half-written entry.
+configuration, the numpy and torch versions and the code of the library layers that make the data
+and train the model (its syntax trees: editing a comment or a docstring keeps the cache). A change
+to any of them gives another key, so a stale entry is never loaded; it is removed when the new one
+is written. A damaged entry (a failed checksum, a truncated
+file) is logged, removed and rebuilt. Checkpoints are written atomically (``model.save``), so an
+interrupted build leaves no half-written entry.
 """
 
 from __future__ import annotations
@@ -163,8 +164,11 @@ def cache_dir() -> Path:
 
 
 def code_fingerprint() -> str:
-    """sha256 of the source files of ``data_synth`` and of the ``meshvae_lib`` modules that make a
-    trained model (not ``_CODE_EXCLUDED``): their relative paths and bytes, in sorted order."""
+    """sha256 of the code of ``data_synth`` and of the ``meshvae_lib`` modules that make a trained
+    model (not ``_CODE_EXCLUDED``): their relative paths and syntax trees, docstrings left out, in
+    sorted order. Comments and docstrings do not change a trained model, so editing them keeps the
+    cache; any change to the code itself (or a new Python whose syntax trees print differently)
+    rebuilds it."""
     import data_synth
     import meshvae_lib
 
@@ -176,8 +180,22 @@ def code_fingerprint() -> str:
             if rel.parts[0] in _CODE_EXCLUDED or rel.as_posix() in _CODE_EXCLUDED:
                 continue
             h.update(f"{package.__name__}/{rel.as_posix()}\0".encode())
-            h.update(path.read_bytes())
+            h.update(_code_without_docstrings(path.read_text()).encode())
     return h.hexdigest()
+
+
+def _code_without_docstrings(source: str) -> str:
+    """``ast.dump`` of ``source`` with every module, class and function docstring removed."""
+    import ast
+
+    tree = ast.parse(source)
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+                    and isinstance(body[0].value.value, str):
+                node.body = body[1:] or [ast.Pass()]
+    return ast.dump(tree)
 
 
 def model_key(spec: CourseModelSpec) -> str:
