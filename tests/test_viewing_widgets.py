@@ -128,6 +128,9 @@ def test_displacement_colouring_and_reference(sphere):
     dec = LinearDecoder(V, 3)
     e = LatentExplorer(dec, 3, F, reference=V, color_by="displacement", mode="threejs")
     assert e.viewer.n_meshes == 2
+    diag = np.linalg.norm(np.ptp(V, axis=0))
+    # nothing has moved yet: the scale is 0 .. 1% of the diagonal, not a degenerate one around 0
+    assert (e.viewer.mapping.vmin, e.viewer.mapping.vmax) == (0.0, pytest.approx(0.01 * diag))
     e.sliders[1].value = 2.0
     disp = np.linalg.norm(2.0 * dec.B[1], axis=1)
     assert e.viewer.mapping.vmax == pytest.approx(disp.max())

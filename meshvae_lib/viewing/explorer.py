@@ -142,6 +142,8 @@ class LatentExplorer(_Displayable):
         if color_by == "displacement":
             viewer_kw.setdefault("values", np.zeros(meshes.shape[:2]))
             viewer_kw.setdefault("cmap", "YlOrRd")
+            viewer_kw.setdefault("vmin", 0.0)
+            viewer_kw.setdefault("vmax", self._displacement_floor())
             viewer_kw.setdefault("value_label", "displacement")
         self.viewer = MeshViewer(meshes, F, titles=titles, **viewer_kw)
 
@@ -255,12 +257,16 @@ class LatentExplorer(_Displayable):
             disp = np.linalg.norm(meshes[-len(self._base):] - self._base, axis=-1)
             if self._reference is not None:
                 disp = np.concatenate([np.zeros((1, disp.shape[1])), disp])
-            floor = EXPLORER_MIN_DISPLACEMENT * float(np.linalg.norm(np.ptp(self._base.reshape(-1, 3), axis=0)))
             self.viewer.set_colors(values=disp, cmap="YlOrRd", vmin=0.0,
-                                   vmax=max(float(disp.max()), floor, 1e-300), value_label="displacement")
+                                   vmax=max(float(disp.max()), self._displacement_floor()), value_label="displacement")
         self.last_update_ms = 1e3 * (time.perf_counter() - t0)
         self._adapt_live_updates()
         self._refresh_status()
+
+    def _displacement_floor(self) -> float:
+        """The least top of the displacement colour scale: a fraction of the mesh's diagonal."""
+        diag = float(np.linalg.norm(np.ptp(self._base.reshape(-1, 3), axis=0)))
+        return max(EXPLORER_MIN_DISPLACEMENT * diag, 1e-300)
 
     @property
     def live(self) -> bool:
