@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.collection import SynthCollection
+from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import grid_tube
 
 __all__ = ["make_bar", "bend_and_twist", "BAR_MOTIONS"]
@@ -24,9 +24,7 @@ BAR_MOTIONS = {"twist": (300.0, 0.0), "bend": (0.0, 240.0), "twist_bend": (270.0
 
 
 def _tube_size(resolution: int) -> tuple[int, int]:
-    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
-        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
-                         f"got {resolution}")
+    resolution = resolve_resolution(resolution)
     # ring spacing = segment length * sqrt(3)/2 gives near-equilateral triangles
     ratio = C.BAR_LENGTH / (2 * np.pi * C.BAR_RADIUS * np.sqrt(3) / 2)
     n_around = max(8, int(round(np.sqrt(resolution / ratio))))

@@ -6,7 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["SynthCollection"]
+from data_synth import constants as C
+
+__all__ = ["SynthCollection", "resolve_resolution"]
 
 
 @dataclass
@@ -53,3 +55,12 @@ class SynthCollection:
     def rest(self) -> np.ndarray:
         """The template in its rest pose, ``(n_vertices, 3) float64`` (``extras['rest']``)."""
         return self.extras["rest"]
+
+
+def resolve_resolution(resolution, default: int | None = None) -> int:
+    """The vertex count a generator is asked for: ``resolution`` (or ``default`` when it is None)
+    as an int, checked against [MIN_RESOLUTION, MAX_RESOLUTION]; ValueError showing the value."""
+    resolution = default if resolution is None else int(resolution)
+    if resolution is None or not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
+        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], got {resolution}")
+    return resolution

@@ -16,7 +16,7 @@ import functools
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.collection import SynthCollection
+from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 from data_synth.skeleton import axis_rotation
 
@@ -68,10 +68,7 @@ def _cached(resolution: int):
 
 def face_template(resolution: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Neutral head ``(V (n, 3) float64, F (m, 3) int64)``, cached and read-only."""
-    resolution = C.FACE_DEFAULT_RESOLUTION if resolution is None else int(resolution)
-    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
-        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
-                         f"got {resolution}")
+    resolution = resolve_resolution(resolution, C.FACE_DEFAULT_RESOLUTION)
     return _cached(resolution)
 
 

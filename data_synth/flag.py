@@ -13,16 +13,14 @@ from __future__ import annotations
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.collection import SynthCollection
+from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import grid_sheet, grid_tube
 
 __all__ = ["make_flag", "flag_frames"]
 
 
 def _grid_size(resolution: int) -> tuple[int, int]:
-    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
-        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
-                         f"got {resolution}")
+    resolution = resolve_resolution(resolution)
     n_u = int(round(np.sqrt(resolution * C.FLAG_ASPECT)))
     n_v = int(round(resolution / n_u))
     return n_u, n_v

@@ -14,7 +14,7 @@ import functools
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.collection import SynthCollection
+from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 from data_synth.skeleton import Skeleton, axis_rotation, forward_kinematics
 from data_synth.skinning import dual_quaternion_blend, skinning_weights
@@ -103,10 +103,7 @@ def _cached(resolution: int):
 
 def hand_template(resolution: int | None = None):
     """``(V (n,3) float64, F (m,3) int64, W (n, 17) float64, skeleton, bone_dirs (17,3))``."""
-    resolution = C.HAND_DEFAULT_RESOLUTION if resolution is None else int(resolution)
-    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
-        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
-                         f"got {resolution}")
+    resolution = resolve_resolution(resolution, C.HAND_DEFAULT_RESOLUTION)
     return _cached(resolution)
 
 

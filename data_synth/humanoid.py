@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from data_synth import constants as C
+from data_synth.collection import resolve_resolution
 from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize, vertex_normals
 from data_synth.skeleton import Skeleton, forward_kinematics
 from data_synth.skinning import dual_quaternion_blend, linear_blend, skinning_weights
@@ -209,10 +210,7 @@ def _cached_template(resolution: int) -> BodyTemplate:
 
 def body_template(resolution: int | None = None) -> BodyTemplate:
     """Template of the average body with about ``resolution`` vertices (cached, read-only)."""
-    resolution = C.HUMANOID_DEFAULT_RESOLUTION if resolution is None else int(resolution)
-    if not C.MIN_RESOLUTION <= resolution <= C.MAX_RESOLUTION:
-        raise ValueError(f"resolution must lie in [{C.MIN_RESOLUTION}, {C.MAX_RESOLUTION}], "
-                         f"got {resolution}")
+    resolution = resolve_resolution(resolution, C.HUMANOID_DEFAULT_RESOLUTION)
     return _cached_template(resolution)
 
 
