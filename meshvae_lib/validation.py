@@ -22,6 +22,7 @@ helper                     accepts, returns
 :func:`check_finite`       no NaN or infinity
 :func:`check_choice`       a string option among its allowed values
 :func:`check_count`        an integer ``>= minimum``
+:func:`check_samples`      a data matrix of at least two finite rows ``(n, k)`` -> float64
 =========================  ===========================================================
 """
 

@@ -25,8 +25,8 @@ from meshvae_lib.defaults import BCE_TARGET_RANGE
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
 
-__all__ = ["TrainResult", "TrainingDiverged", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object", "pca_network",
-           "to_output_range", "from_output_range"]
+__all__ = ["TrainResult", "TrainingDiverged", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object",
+           "pca_network", "to_output_range", "from_output_range"]
 
 logger = logging.getLogger(__name__)
 
@@ -263,7 +263,7 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
         if not np.isfinite(sums["total"]):
             bar.close()
             raise TrainingDiverged(f"training diverged at epoch {epoch + 1} (loss {sums['total']}); try a smaller"
-                             f" learning rate (now {config.lr:g}) or alpha (now {config.alpha:g})")
+                                   f" learning rate (now {config.lr:g}) or alpha (now {config.alpha:g})")
         last = epoch + 1 == epochs
         if select:
             if (epoch + 1) % config.eval_every == 0 or last:

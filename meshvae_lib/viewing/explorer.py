@@ -134,6 +134,10 @@ class LatentExplorer(_Displayable):
 
         meshes = self._decode_meshes(self._z)
         self._base = meshes.copy()
+        #: the least top of the displacement colour scale: a fraction of the mesh's diagonal (at the
+        #: start every displacement is 0, and a zero-width scale says nothing)
+        self._displacement_floor = max(
+            EXPLORER_MIN_DISPLACEMENT * float(np.linalg.norm(np.ptp(self._base.reshape(-1, 3), axis=0))), 1e-300)
         self._reference = None
         if reference is not None:
             ref = as_mesh_stack(reference, n_meshes=1, n_vertices=meshes.shape[1])
@@ -143,7 +147,7 @@ class LatentExplorer(_Displayable):
             viewer_kw.setdefault("values", np.zeros(meshes.shape[:2]))
             viewer_kw.setdefault("cmap", "YlOrRd")
             viewer_kw.setdefault("vmin", 0.0)
-            viewer_kw.setdefault("vmax", self._displacement_floor())
+            viewer_kw.setdefault("vmax", self._displacement_floor)
             viewer_kw.setdefault("value_label", "displacement")
         self.viewer = MeshViewer(meshes, F, titles=titles, **viewer_kw)
 
@@ -258,15 +262,10 @@ class LatentExplorer(_Displayable):
             if self._reference is not None:
                 disp = np.concatenate([np.zeros((1, disp.shape[1])), disp])
             self.viewer.set_colors(values=disp, cmap="YlOrRd", vmin=0.0,
-                                   vmax=max(float(disp.max()), self._displacement_floor()), value_label="displacement")
+                                   vmax=max(float(disp.max()), self._displacement_floor), value_label="displacement")
         self.last_update_ms = 1e3 * (time.perf_counter() - t0)
         self._adapt_live_updates()
         self._refresh_status()
-
-    def _displacement_floor(self) -> float:
-        """The least top of the displacement colour scale: a fraction of the mesh's diagonal."""
-        diag = float(np.linalg.norm(np.ptp(self._base.reshape(-1, 3), axis=0)))
-        return max(EXPLORER_MIN_DISPLACEMENT * diag, 1e-300)
 
     @property
     def live(self) -> bool:
