@@ -1,12 +1,19 @@
 """Printing numbers in a lesson so that its stored outputs are the same on every machine.
 
 Round-off (an error of 1e-15 on one CPU, 3e-16 on another) is printed as a bound, not as its
-digits; everything above the bound is printed as usual.
+digits; everything above the bound is printed as usual. A choice among values that tie up to
+round-off (two frames of a periodic motion) is made by a stated rule, not by the last bits.
 """
 
 from __future__ import annotations
 
-__all__ = ["roundoff"]
+import numpy as np
+
+__all__ = ["roundoff", "first_argmax", "TIE_RTOL"]
+
+#: values within this fraction of the largest count as tied in :func:`first_argmax`: far above
+#: round-off (1e-16 to 1e-13 after a few thousand operations), far below any printed digit.
+TIE_RTOL = 1e-9
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -19,3 +26,24 @@ def roundoff(x: float, below: float = 1e-10) -> str:
         raise ValueError(f"below must be > 0, got {below}")
     x = float(x)
     return f"< {below:.0e}" if abs(x) < below else f"{x:.1e}"
+
+
+def first_argmax(values, rtol: float = TIE_RTOL) -> int:
+    """The index of the largest value, ties broken by the earliest index: the first ``i`` with
+    ``values[i] >= max - rtol * |max|``.
+
+    values : (n,) finite reals, n >= 1; rtol : float >= 0, how close to the largest value (relative)
+    counts as a tie. ``np.argmax`` also returns the first of equal values, but two frames of a
+    periodic motion that tie mathematically differ in their last bits, and which one is larger
+    then depends on the CPU and its BLAS kernels (notebook 00: frames 30 and 90 of the jumping
+    jacks, 8e-16 apart). Returns an int.
+    """
+    x = np.asarray(values, dtype=np.float64)
+    if x.ndim != 1 or len(x) == 0:
+        raise ValueError(f"values must be a non-empty 1-D array, got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("values must be finite")
+    if not rtol >= 0:
+        raise ValueError(f"rtol must be >= 0, got {rtol}")
+    top = x.max()
+    return int(np.flatnonzero(x >= top - rtol * abs(top))[0])
