@@ -7,6 +7,7 @@ Used by the Makefile (``make notebooks``, ``make course``, ``make student``, ``m
     python -m meshvae_lib.course student --out build/student notebooks/0*.ipynb
     python -m meshvae_lib.course models            # build every missing course model
     python -m meshvae_lib.course architecture      # regenerate docs/ARCHITECTURE.md's module tables
+    python -m meshvae_lib.course portable --command "pytest notebooks ..." "A=1" "B=2 C=3"   # make test-portable
 """
 
 from __future__ import annotations
@@ -152,6 +153,16 @@ def _cmd_architecture(args) -> int:
     return 0
 
 
+def _cmd_portable(args) -> int:
+    import shlex
+
+    from .portable import run_settings, summary
+
+    results = run_settings(args.settings, shlex.split(args.command), args.logs)
+    print(summary(results), flush=True)
+    return 0 if all(r.ok for r in results) else 1
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m meshvae_lib.course", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -181,6 +192,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--page", default="docs/ARCHITECTURE.md", help="the page to rewrite (default docs/ARCHITECTURE.md)")
     p.add_argument("--check", action="store_true", help="only say whether the page is current (exit 1 if stale)")
     p.set_defaults(func=_cmd_architecture)
+    p = sub.add_parser("portable", help="run a test command under each float setting, all of them, and list the "
+                                        "failures by setting (make test-portable)")
+    p.add_argument("settings", nargs="+", metavar="SETTING", help='environment assignments, e.g. "OPENBLAS_CORETYPE=Haswell"')
+    p.add_argument("--command", required=True, help="the command to run under each setting (one string)")
+    p.add_argument("--logs", default="build/portable", help="folder for one log per setting (default build/portable)")
+    p.set_defaults(func=_cmd_portable)
     args = parser.parse_args(argv)
     try:
         return args.func(args)
