@@ -98,3 +98,6 @@ EXPLORER_MIN_DISPLACEMENT = 0.01
 #: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
 #: takes less than this many milliseconds; slower models switch to decoding on release.
 LIVE_UPDATE_MAX_MS = 150.0
+#: a progress bar (meshvae_lib.progress) whose stream is not a terminal -- a CI log, a pipe --
+#: redraws at most every this many seconds (in a terminal or a notebook: tqdm's 0.1 s).
+PROGRESS_LOG_SECONDS = 10.0

@@ -128,3 +128,9 @@ DUPLICATE_DISTANCE_RTOL = 1e-9
 #: retrieval.precision_recall_curve: slack when the rank reaching recall rho is rounded up, so that
 #: rho * n_relevant landing exactly on an integer is not pushed to the next rank by round-off.
 RECALL_RANK_SLACK = 1e-9
+
+# --- course: lessons whose printed outputs must not depend on the last bits (issue 21) ---------
+#: course.display.first_argmax: values within this fraction of the largest count as tied, and the
+#: earliest is taken. Far above round-off (1e-16 to 1e-13 after a few thousand operations; two
+#: frames of notebook 00 tie to 8e-16), far below any digit a lesson prints.
+TIE_RTOL = 1e-9

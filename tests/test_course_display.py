@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from meshvae_lib.course.display import TIE_RTOL, first_argmax
+from meshvae_lib.course.display import first_argmax
+from meshvae_lib.tolerances import TIE_RTOL
 
 
 def test_the_earliest_of_values_tied_to_the_last_bits():

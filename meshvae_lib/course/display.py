@@ -9,11 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["roundoff", "first_argmax", "TIE_RTOL"]
+from meshvae_lib.tolerances import TIE_RTOL
 
-#: values within this fraction of the largest count as tied in :func:`first_argmax`: far above
-#: round-off (1e-16 to 1e-13 after a few thousand operations), far below any printed digit.
-TIE_RTOL = 1e-9
+__all__ = ["roundoff", "first_argmax"]
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:

@@ -26,6 +26,7 @@ import numpy as np
 from meshvae_lib.geometry.collection import MeshCollection, default_names
 from meshvae_lib.geometry.mesh_checks import validate_mesh
 from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
+from meshvae_lib.progress import progress as progress_bar
 
 __all__ = ["read_collection", "write_collection", "natural_key"]
 
@@ -198,9 +199,7 @@ def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshColl
         raise ValueError(f"{path}: several files share the name(s) {dup[:5]} (different suffixes)")
     it = files
     if progress and len(files) > 20:
-        from tqdm.auto import tqdm
-
-        it = tqdm(files, desc="reading meshes", unit="mesh")
+        it = progress_bar(files, desc="reading meshes", unit="mesh")
     V_ref = F_ref = None
     verts = []
     for k, p in enumerate(it):

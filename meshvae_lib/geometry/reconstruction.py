@@ -32,6 +32,7 @@ from meshvae_lib.geometry.position_solvers import ExactPositionSolver, PaperPosi
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.geometry.rotation_recovery import RotationRecovery
 from meshvae_lib.geometry.rotations import exp_soa, matmul_soa
+from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.validation import check_choice, check_count, check_finite
 
 __all__ = ["RIMDReconstructor"]
@@ -154,9 +155,7 @@ class RIMDReconstructor:
         out = np.empty((N, n, 3))
         it = range(N)
         if progress:
-            from tqdm.auto import tqdm
-
-            it = tqdm(it, desc="reconstructing", unit="mesh")
+            it = progress_bar(it, desc="reconstructing", unit="mesh")
         for k in it:
             log_dR, S = self.layout.unpack(f[k])
             w = np.ascontiguousarray(log_dR[0].T)

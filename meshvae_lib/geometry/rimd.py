@@ -37,6 +37,7 @@ from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperato
 from meshvae_lib.geometry.polar import polar_rs_soa
 from meshvae_lib.geometry.rotations import quat_from_soa, relative_log_quat
 from meshvae_lib.geometry.topology import directed_edges, edge_index, edges
+from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.validation import check_choice, check_faces, check_rows
 
 __all__ = ["S_ENTRIES", "RIMDLayout", "RIMDEncoder", "rimd_features"]
@@ -298,9 +299,7 @@ class RIMDEncoder:
         batch_size = max(1, int(batch_size))
         starts = range(0, N, batch_size)
         if progress:
-            from tqdm.auto import tqdm
-
-            starts = tqdm(starts, desc="RIMD features", unit="batch")
+            starts = progress_bar(starts, desc="RIMD features", unit="batch")
         for s in starts:
             out[s:s + batch_size] = self._transform_batch(Vb[s:s + batch_size])
         return out[0] if single else out

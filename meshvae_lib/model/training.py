@@ -24,6 +24,7 @@ from meshvae_lib.tolerances import PCA_INIT_RTOL
 from meshvae_lib.defaults import BCE_TARGET_RANGE
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
+from meshvae_lib.progress import progress as progress_bar
 
 __all__ = ["TrainResult", "TrainingDiverged", "train_vae", "holdout_mask", "resolve_device", "pad_sigma_object",
            "pca_network", "to_output_range", "from_output_range"]
@@ -235,15 +236,13 @@ def _run(model, x, c, config, epochs, device, xv=None, cv=None, so_t=None, selec
     shuffle_gen = torch.Generator().manual_seed(config.seed + 1)
     noise_gen = torch.Generator(device=device).manual_seed(config.seed + 2)
 
-    from tqdm.auto import tqdm
-
     history: list[dict] = []
     best_epoch, best_val = 0, np.inf
     y, scale = _targets(model, x, config), _mse_scale(model, config)
     if select:
         best_val = _evaluate(model, xv, cv, config, so_t)["val_mse"]
         history.append({"epoch": 0, "val_mse": best_val})
-    bar = tqdm(range(epochs), desc=desc, unit="epoch", disable=not config.progress)
+    bar = progress_bar(range(epochs), desc=desc, unit="epoch", disable=not config.progress)
     for epoch in bar:
         model.train()
         sums = {"total": 0.0, "reconstruction": 0.0, "kl": 0.0, "mse": 0.0}
