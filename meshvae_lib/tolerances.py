@@ -134,3 +134,22 @@ RECALL_RANK_SLACK = 1e-9
 #: earliest is taken. Far above round-off (1e-16 to 1e-13 after a few thousand operations; two
 #: frames of notebook 00 tie to 8e-16), far below any digit a lesson prints.
 TIE_RTOL = 1e-9
+
+# --- latent inference by Gauss-Newton (model.inference, issue 23) -------------------------------
+#: geometry.sparse_lu.solve_columns: right-hand sides per SuperLU solve (it slows beyond ~16).
+SPARSE_SOLVE_CHUNK = 12
+#: Levenberg-Marquardt damping of the Gauss-Newton inference, as a fraction of the mean diagonal of
+#: J^T J: where it starts, how it grows on a rejected step and shrinks on an accepted one, its floor
+#: and the number of tries per iteration before the fit stops. Measured on samba, pdance and pcow:
+#: undamped steps overshoot on the first iteration (the encoder's code is far off on real meshes).
+GN_DAMPING_START = 1e-3
+GN_DAMPING_UP = 10.0
+GN_DAMPING_DOWN = 0.3
+GN_DAMPING_FLOOR = 1e-5
+GN_MAX_TRIES = 6
+#: the fit stops early when an accepted step lowers the squared vertex error by less than this
+#: fraction.
+GN_REL_DECREASE = 1e-4
+#: a latent dimension whose decoded-feature Jacobian column is below this fraction of the largest
+#: takes no part in the fit (a PCA-started decoder leaves the dimensions beyond the data's rank at 0).
+GN_UNUSED_DIM_RTOL = 1e-9

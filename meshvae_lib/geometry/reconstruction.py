@@ -29,6 +29,7 @@ from meshvae_lib.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
 from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
 from meshvae_lib.geometry.position_solvers import ExactPositionSolver, PaperPositionSolver
+from meshvae_lib.geometry.reconstruction_linearization import ReconstructionLinearization
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.geometry.rotation_recovery import RotationRecovery
 from meshvae_lib.geometry.rotations import exp_soa, matmul_soa
@@ -100,6 +101,50 @@ class RIMDReconstructor:
     def __repr__(self) -> str:
         return (f"RIMDReconstructor(method={self.method!r}, layout={self.layout.layout!r}, "
                 f"rotations={self.rotations!r}, n_vertices={self.n_vertices})")
+
+    @property
+    def rotation_recovery(self) -> RotationRecovery:
+        """The rotation recovery of this mesh (its graph Laplacian factorised once)."""
+        return self._rotation_recovery
+
+    @property
+    def position_solver(self) -> ExactPositionSolver | PaperPositionSolver:
+        """The position solve of this mesh (its system factorised once)."""
+        return self._positions
+
+    def linearize(self, features) -> ReconstructionLinearization:
+        """Reconstruct one feature vector and linearise the reconstruction around it.
+
+        Parameters
+        ----------
+        features : (K,) float
+            In this reconstructor's layout.
+
+        Returns
+        -------
+        ReconstructionLinearization
+            ``.positions (n_vertices, 3)`` (not aligned to the reference) and the products
+            ``jvp(dF)`` / ``vjp(dP)`` with ``dp/df`` (see
+            :mod:`meshvae_lib.geometry.reconstruction_linearization`).
+
+        Raises
+        ------
+        ValueError
+            For the BFS rotation recovery or the paper's local-global iterations, which are not
+            linearised (the exact method with global rotations, the default, is).
+        """
+        if self.rotations != "global" or (self.method == "paper" and self.iterations):
+            raise ValueError("linearize needs rotations='global' and no local-global iterations, got "
+                             f"rotations={self.rotations!r}, method={self.method!r}, iterations={self.iterations}")
+        f = check_finite(self.layout.check_features(features), "features")
+        if f.ndim != 1:
+            raise ValueError(f"linearize takes one feature vector ({self.layout.K},), got {f.shape}")
+        log_dR, S = self.layout.unpack(f)
+        w = np.ascontiguousarray(log_dR[0].T)
+        Ssoa = np.ascontiguousarray(S[0].reshape(self.n_vertices, 9).T)
+        R = self._rotation_recovery(w)
+        P = self._positions(matmul_soa(R, Ssoa))
+        return ReconstructionLinearization(self, w, Ssoa, R, P)
 
     def recover_rotations(self, log_dR) -> np.ndarray:
         """Per-vertex rotations from edge rotation vectors, up to one global rotation.

@@ -102,6 +102,25 @@ class RIMDLayout:
         self.scaling_slice = slice(r, r + 6 * n_vertices)
         self.K = r + 6 * n_vertices
 
+    @property
+    def forward_blocks(self) -> np.ndarray:
+        """Paper layout: for each undirected edge ``(i, j)``, ``i < j``, the row of
+        ``rotation_edges`` that stores ``log dR_ij``: (n_edges,) int64, read-only."""
+        return self._paper_blocks(self._forward)
+
+    @property
+    def backward_blocks(self) -> np.ndarray:
+        """Paper layout: for each undirected edge ``(i, j)``, the row that stores ``log dR_ji``:
+        (n_edges,) int64, read-only."""
+        return self._paper_blocks(self._backward)
+
+    def _paper_blocks(self, blocks: np.ndarray) -> np.ndarray:
+        if self.layout != "paper":
+            raise ValueError(f"only the paper layout stores both directions of an edge; this one is {self.layout!r}")
+        view = blocks.view()
+        view.setflags(write=False)
+        return view
+
     def __repr__(self) -> str:
         return (f"RIMDLayout(layout={self.layout!r}, n_vertices={self.n_vertices}, "
                 f"n_edges={self.n_edges}, K={self.K})")

@@ -29,7 +29,7 @@ from meshvae_lib import tolerances as tol
 from meshvae_lib.defaults import ROTATION_RECOVERY
 from meshvae_lib.geometry.rotations import (
     exp_soa, matmul_soa, quat_exp_soa, quat_from_soa, quat_mul_soa)
-from meshvae_lib.geometry.sparse_lu import factorize_spd, pinning
+from meshvae_lib.geometry.sparse_lu import factorize_spd, pinning, solve_columns
 from meshvae_lib.geometry.topology import edge_index
 from meshvae_lib.validation import check_choice
 
@@ -127,6 +127,7 @@ class RotationRecovery:
              (np.concatenate([np.arange(nE)] * 2), np.concatenate([E[:, 0], E[:, 1]]))),
             shape=(nE, n),
         )
+        self._G = G
         self._Gt = G.T.tocsr()
         self._sync_lu = factorize_spd(G.T @ G + pinning(n, self.roots, 1.0))
 
@@ -203,3 +204,29 @@ class RotationRecovery:
             R, sweeps = self.synchronize(R, w)
             logger.debug("rotation sync: %d sweeps", sweeps)
         return R
+
+    # -- first-order response (geometry.reconstruction_linearization) -------------------------
+    def linear_response(self, rho: np.ndarray) -> np.ndarray:
+        """Global-frame rotation increments ``g`` for edge-rotation changes ``rho``.
+
+        Where the edge rotations are consistent (``R_i dR_ij = R_j``), the synchronisation's
+        least-squares optimality condition is linear with the factorised graph Laplacian:
+        ``L g = G^T rho``, ``R_i <- exp(hat(g_i)) R_i``.
+
+        Parameters
+        ----------
+        rho : (n_edges, 3, d) float64
+            Per edge, the change of ``R_j``'s direction requested by the edge, in the global frame.
+
+        Returns
+        -------
+        g : (n_vertices, 3, d) float64
+        """
+        E, _, d = rho.shape
+        return solve_columns(self._sync_lu, self._Gt @ rho.reshape(E, 3 * d)).reshape(self.n_vertices, 3, d)
+
+    def linear_response_adjoint(self, g_adj: np.ndarray) -> np.ndarray:
+        """The transpose of :meth:`linear_response`: ``(n_vertices, 3, d) -> (n_edges, 3, d)``."""
+        n, _, d = g_adj.shape
+        mu = solve_columns(self._sync_lu, g_adj.reshape(n, 3 * d))   # the Laplacian is symmetric
+        return (self._G @ mu).reshape(-1, 3, d)

@@ -1,0 +1,180 @@
+"""First-order behaviour of the RIMD reconstruction: Jacobian-vector and adjoint products.
+
+:meth:`RIMDReconstructor.linearize(f) <meshvae_lib.geometry.reconstruction.RIMDReconstructor.linearize>`
+reconstructs the mesh of one feature vector ``f`` and returns a :class:`ReconstructionLinearization`:
+the positions ``p(f)`` (before the final rigid alignment) and the products of the Jacobian
+``dp/df`` with feature-space directions (:meth:`~ReconstructionLinearization.jvp`) and of its
+transpose with vertex-space fields (:meth:`~ReconstructionLinearization.vjp`). They let a decoder's
+latent code be fitted to vertex positions by Gauss-Newton without differencing the reconstruction
+(:mod:`meshvae_lib.model.inference`). Notation of docs/vae.md, "Inference by Gauss-Newton".
+
+The reconstruction has three steps (:mod:`meshvae_lib.geometry.reconstruction`), and so has its
+derivative. For a perturbation ``df`` of the feature:
+
+1. an edge rotation ``dR_e = exp(hat(w_e))`` of edge ``e = (i, j)`` turns by
+   ``eta_e = J_r(w_e) dw_e`` in its own frame (``J_r``: the right Jacobian of the SO(3)
+   exponential), where ``dw_e`` is the change of the edge's rotation vector (for the paper layout
+   the mean of its two stored directions, as :meth:`RIMDLayout.unpack` takes it);
+2. the rotation synchronisation responds with global-frame increments ``g_i``
+   (``R_i <- exp(hat(g_i)) R_i``). Where the edge rotations are consistent (``R_i dR_ij = R_j``)
+   its least-squares optimality condition is linear with the fixed graph Laplacian its sweeps
+   already factorise: ``L g = G^T rho`` with ``rho_e = R_j eta_e``;
+3. ``T_i = R_i S_i`` changes by ``dT_i = hat(g_i) T_i + R_i dS_i``, and the positions by the
+   position solve of ``dT`` -- again a fixed, factorised matrix.
+
+So a Jacobian-vector product costs two sparse solves with already-factorised matrices, and the
+adjoint the same two solves in reverse order (the matrices are symmetric). Decoded features are
+close to, not exactly, consistent; the formula of step 2 then describes the synchronisation to
+first order only. Measured on a real 10k-vertex performance capture at a decoder's output: within
+0.1-0.3% of forward differences of the reconstruction. The exact solver's optional Gauss-Newton
+refinement (active only for meshes with perfectly symmetric one-rings, ``refine_active``) is not
+differentiated: it changes positions by ~1e-5 of the diagonal.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from meshvae_lib.geometry.rimd import S_ENTRIES
+from meshvae_lib.geometry.rotations import matmul_soa
+
+__all__ = ["ReconstructionLinearization", "right_jacobian_soa"]
+
+#: ``hat(e_k)`` for the unit vectors e_0, e_1, e_2.
+_GENERATORS = np.zeros((3, 3, 3))
+_GENERATORS[0, 2, 1], _GENERATORS[0, 1, 2] = 1.0, -1.0
+_GENERATORS[1, 0, 2], _GENERATORS[1, 2, 0] = 1.0, -1.0
+_GENERATORS[2, 1, 0], _GENERATORS[2, 0, 1] = 1.0, -1.0
+#: the 6 stored entries of a symmetric S -> its 9 row-major entries.
+_S6_TO_9 = np.zeros((9, 6))
+for _k, (_a, _b) in enumerate(S_ENTRIES):
+    _S6_TO_9[3 * _a + _b, _k] = 1.0
+    _S6_TO_9[3 * _b + _a, _k] = 1.0
+
+
+def right_jacobian_soa(w: np.ndarray) -> np.ndarray:
+    """Right Jacobians of the SO(3) exponential: ``exp(hat(w + d)) ~ exp(hat(w)) exp(hat(J_r(w) d))``.
+
+    Parameters
+    ----------
+    w : (m, 3) float64
+        Rotation vectors.
+
+    Returns
+    -------
+    J : (m, 3, 3) float64
+        ``J_r(w) = I - (1 - cos t) / t^2 hat(w) + (t - sin t) / t^3 hat(w)^2``, ``t = |w|``
+        (series below 1e-4 rad).
+    """
+    w = np.asarray(w, dtype=np.float64)
+    t = np.sqrt(np.einsum("mi,mi->m", w, w))
+    small = t < 1e-4
+    ts = np.where(small, 1.0, t)
+    a = np.where(small, 0.5 - t ** 2 / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
+    b = np.where(small, 1.0 / 6.0 - t ** 2 / 120.0, (ts - np.sin(ts)) / ts ** 3)
+    W = np.einsum("mk,kab->mab", w, _GENERATORS)
+    return np.eye(3) - a[:, None, None] * W + b[:, None, None] * (W @ W)
+
+
+class ReconstructionLinearization:
+    """The reconstruction of one feature vector and its first-order behaviour around it.
+
+    Built by :meth:`RIMDReconstructor.linearize`; see the module docstring.
+
+    Attributes
+    ----------
+    positions : (n_vertices, 3) float64
+        ``p(f)``: the reconstructed mesh before the final rigid alignment onto the reference.
+    n_features : int
+        K of the layout.
+    """
+
+    def __init__(self, reconstructor, w: np.ndarray, S: np.ndarray, R: np.ndarray, positions: np.ndarray):
+        layout = reconstructor.layout
+        n = layout.n_vertices
+        self._layout = layout
+        self._rotations = reconstructor.rotation_recovery
+        self._positions_solver = reconstructor.position_solver
+        self.positions = positions
+        self.positions.setflags(write=False)
+        self.n_features = int(layout.K)
+        Rm = np.ascontiguousarray(R.T).reshape(n, 3, 3)
+        Tm = np.ascontiguousarray(matmul_soa(R, S).T).reshape(n, 3, 3)
+        # edge e = (i, j): d(edge rotation vector) -> rho_e = R_j J_r(w_e) dw_e
+        self._edge_map = Rm[layout.edges[:, 1]] @ right_jacobian_soa(np.ascontiguousarray(w.T))
+        # g_i -> dT_i = hat(g_i) T_i, as (9, 3) per vertex; dS6_i -> R_i dS_i, as (9, 6)
+        self._g_map = np.einsum("kac,ncb->nabk", _GENERATORS, Tm).reshape(n, 9, 3)
+        self._s_map = np.einsum("nac,cbk->nabk", Rm, _S6_TO_9.reshape(3, 3, 6)).reshape(n, 9, 6)
+
+    # -- feature space <-> per-edge / per-vertex blocks ----------------------------------------
+    def _split(self, dF: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        lay = self._layout
+        d = dF.shape[1]
+        rot = dF[lay.rotation_slice].reshape(lay.n_rotation_edges, 3, d)
+        if lay.layout == "paper":
+            dw = 0.5 * (rot[lay.forward_blocks] - rot[lay.backward_blocks])
+        else:
+            dw = rot
+        return dw, dF[lay.scaling_slice].reshape(lay.n_vertices, 6, d)
+
+    def _join(self, dw_adj: np.ndarray, dS6_adj: np.ndarray) -> np.ndarray:
+        lay = self._layout
+        d = dw_adj.shape[2]
+        out = np.zeros((lay.K, d))
+        rot = out[lay.rotation_slice].reshape(lay.n_rotation_edges, 3, d)
+        if lay.layout == "paper":
+            rot[lay.forward_blocks] = 0.5 * dw_adj
+            rot[lay.backward_blocks] = -0.5 * dw_adj
+        else:
+            rot[:] = dw_adj
+        out[lay.scaling_slice] = dS6_adj.reshape(-1, d)
+        return out
+
+    # -- products -----------------------------------------------------------------------------
+    def jvp(self, dF) -> np.ndarray:
+        """Position changes for feature changes: ``dp/df @ dF``.
+
+        Parameters
+        ----------
+        dF : (K,) or (K, d) float
+            Feature-space directions, in the reconstructor's layout.
+
+        Returns
+        -------
+        dP : (n_vertices, 3) or (n_vertices, 3, d) float64
+        """
+        dF = np.asarray(dF, dtype=np.float64)
+        single = dF.ndim == 1
+        dF = dF[:, None] if single else dF
+        if dF.ndim != 2 or dF.shape[0] != self.n_features:
+            raise ValueError(f"dF must have shape ({self.n_features},) or ({self.n_features}, d), got {dF.shape}")
+        dw, dS6 = self._split(dF)
+        g = self._rotations.linear_response(self._edge_map @ dw)           # (n, 3, d)
+        dT = self._g_map @ g + self._s_map @ dS6                          # (n, 9, d)
+        dP = self._positions_solver.solve_gradients(dT)                   # (n, 3, d)
+        return dP[:, :, 0] if single else dP
+
+    def vjp(self, dP) -> np.ndarray:
+        """Feature-space gradients of vertex fields: ``(dp/df)^T @ dP``.
+
+        Parameters
+        ----------
+        dP : (n_vertices, 3) or (n_vertices, 3, d) float
+
+        Returns
+        -------
+        dF : (K,) or (K, d) float64
+        """
+        dP = np.asarray(dP, dtype=np.float64)
+        single = dP.ndim == 2
+        dP = dP[:, :, None] if single else dP
+        n = self._layout.n_vertices
+        if dP.ndim != 3 or dP.shape[:2] != (n, 3):
+            raise ValueError(f"dP must have shape ({n}, 3) or ({n}, 3, d), got {dP.shape}")
+        dT_adj = self._positions_solver.solve_gradients_adjoint(dP)        # (n, 9, d)
+        g_adj = self._g_map.transpose(0, 2, 1) @ dT_adj                  # (n, 3, d)
+        dS6_adj = self._s_map.transpose(0, 2, 1) @ dT_adj                 # (n, 6, d)
+        rho_adj = self._rotations.linear_response_adjoint(g_adj)          # (E, 3, d)
+        dw_adj = self._edge_map.transpose(0, 2, 1) @ rho_adj
+        dF = self._join(dw_adj, dS6_adj)
+        return dF[:, 0] if single else dF
