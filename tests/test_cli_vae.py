@@ -162,11 +162,20 @@ def test_evaluate_reports_the_pca_baseline(data, capsys):
 def test_evaluate_with_codes_fitted_to_the_vertices(data, capsys):
     root, path, model, coll = data
     capsys.readouterr()
-    assert main(["evaluate", str(model), str(path), "--held-out", "--json"]) == 0
-    plain = json.loads(capsys.readouterr().out)["mean_vertex_error"]
+    assert main(["evaluate", str(model), str(path), "--held-out", "--json", "--inference", "encoder"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert plain["inference"] == "encoder"
     assert main(["evaluate", str(model), str(path), "--held-out", "--fit-latent", "2", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
-    assert res["fit_iterations"] == 2 and res["mean_vertex_error"] <= plain + 1e-12
+    assert res["fit_iterations"] == 2 and res["inference"] == "finite-difference"
+    assert res["mean_vertex_error"] <= plain["mean_vertex_error"] + 1e-12
+    # the default: Gauss-Newton from the encoder's means, never worse than them
+    assert main(["evaluate", str(model), str(path), "--held-out", "--json"]) == 0
+    default = json.loads(capsys.readouterr().out)
+    assert default["inference"] == "gauss-newton"
+    assert all(d <= p * (1 + 1e-6) + 1e-12 for d, p in zip(default["per_mesh"], plain["per_mesh"]))
+    assert main(["evaluate", str(model), str(path), "--fit-latent", "2", "--inference", "encoder"]) == 2
+    assert "does not combine" in capsys.readouterr().err
     assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 2
     assert "--fit-latent must be >= 0" in capsys.readouterr().err
 

@@ -136,7 +136,8 @@ def test_pca_recovers_a_low_rank_collection_and_aligned_pca_removes_rigid_motion
 def test_default_rimd_model_generalises_better_than_coordinate_pca_and_the_papers_training():
     """Issue 12 on the course's non-linear body collection: the library's default (PCA start,
     early stopping) against PCA of the coordinates with as many components as latent dimensions,
-    and against the paper's training (random start, all epochs) on the same held-out meshes.
+    and against the paper's path (random start, all epochs, the network's encoder) on the same
+    held-out meshes; the default encodes by Gauss-Newton from the encoder's means (issue 23).
     Measured (seed 0, 302 vertices, latent 16): default 1.2e-2 (training meshes 8.5e-3), PCA 2.2e-2, paper's training 5.6e-2."""
     from data_synth.registry import make_collection
     from meshvae_lib.model.meshvae_model import MeshVAEModel
@@ -152,7 +153,7 @@ def test_default_rimd_model_generalises_better_than_coordinate_pca_and_the_paper
     held = default.holdout_mask_
     err = evaluate_model(default, coll, held_out_only=True)["mean_vertex_error"]
     err_train = evaluate_model(default, coll, indices=np.flatnonzero(~held))["mean_vertex_error"]
-    err_paper = evaluate_model(paper, coll, held_out_only=True)["mean_vertex_error"]
+    err_paper = evaluate_model(paper, coll, held_out_only=True, inference="encoder")["mean_vertex_error"]   # the paper's path
     floor = pca_baseline(coll.vertices[~held], coll.vertices[held], n_components=latent)["mean_vertex_error"]
     assert err < 0.8 * floor, (err, floor)
     assert err < 0.6 * err_paper, (err, err_paper)

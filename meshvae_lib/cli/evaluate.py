@@ -5,11 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 
+from meshvae_lib.defaults import INFERENCE_METHODS
+
 from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, result
 
 DESCRIPTION = """\
-Encode every mesh of DATA to its latent mean, decode it, align it rigidly to the original and
-report the mean per-vertex distance (the error of the paper's Table 2), in the mesh's own units.
+Encode every mesh of DATA, decode it, align it rigidly to the original and report the mean
+per-vertex distance (the error of the paper's Table 2), in the mesh's own units. By default a
+mesh's code is the encoder's mean refined by a few Gauss-Newton steps on the vertex error
+(--inference gauss-newton, docs/vae.md "Inference by Gauss-Newton"); --inference encoder is the
+paper's feed-forward encoder alone.
 With --held-out only the meshes held out during training are measured (DATA must then be the
 training collection).
 
@@ -18,7 +23,8 @@ examples:
   meshvae evaluate scape.pt scape.npz --held-out --json
   meshvae evaluate scape.pt scape.npz --held-out --pca          # + linear PCA on the training meshes
   meshvae evaluate scape.pt held_out.npz --pca train.npz        # PCA fitted on another file
-  meshvae evaluate scape.pt scape.npz --held-out --fit-latent 3  # codes fitted to the vertices
+  meshvae evaluate scape.pt scape.npz --held-out --inference encoder  # the paper's encoder
+  meshvae evaluate scape.pt scape.npz --held-out --fit-latent 3  # codes fitted by finite differences
 
 --pca adds the linear floor: PCA on vertex coordinates fitted on the training meshes (by default
 the meshes of DATA the model did not hold out; or those of the given file), with all the
@@ -34,10 +40,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--held-out", action="store_true", help="only the meshes held out in training")
     p.add_argument("--json", action="store_true",
                    help="print JSON (mean_vertex_error, n_meshes, relative_error, per_mesh, names)")
+    p.add_argument("--inference", choices=INFERENCE_METHODS, default=None,
+                   help="how a mesh's code is found (default: the model's own, normally gauss-newton: the encoder's"
+                        " mean, then Gauss-Newton steps on the vertex error with the analytic Jacobian; encoder: the"
+                        " paper's feed-forward encoder; finite-difference: Gauss-Newton by forward differences)")
     p.add_argument("--fit-latent", type=int, default=0, metavar="N",
-                   help="fit each mesh's latent code to its vertex positions with N Gauss-Newton steps through the"
-                        " decoder instead of using the encoder (an option beside the paper's; slower: N x (D + 1)"
-                        " decodes per mesh)")
+                   help="fit each mesh's latent code with N Gauss-Newton steps by finite differences (the reference"
+                        " for --inference gauss-newton; slower: N x (D + 1) decodes per mesh)")
     p.add_argument("--pca", nargs="?", const="", default=None, metavar="TRAIN",
                    help="also report linear PCA on coordinates fitted on the training meshes: those of DATA"
                         " not held out (no value), or all meshes of the collection TRAIN")
@@ -55,7 +64,10 @@ def run(args) -> int:
     check_at_least(args.fit_latent, 0, "--fit-latent")
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
-    res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent)
+    if args.fit_latent and args.inference not in (None, "finite-difference"):
+        raise UsageError(f"--fit-latent fits by finite differences; it does not combine with --inference {args.inference}")
+    res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent,
+                         inference=args.inference)
     if args.pca is not None:
         import numpy as np
 
@@ -79,7 +91,9 @@ def run(args) -> int:
         worst = max(range(res["n_meshes"]), key=lambda i: res["per_mesh"][i])
         result(f"mean per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
                f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal; features {res['features']}"
-               + (f"; codes fitted to the vertices, {args.fit_latent} steps" if args.fit_latent else "") + ")")
+               + f"; inference {res['inference']}"
+               + (f", {args.fit_latent} steps" if args.fit_latent else "")
+               + f"; {res['seconds_per_mesh']:.2g} s per mesh)")
         result(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
         if "pca" in res:
             pca = res["pca"]

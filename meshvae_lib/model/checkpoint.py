@@ -93,7 +93,7 @@ def write_checkpoint(path, model: MeshVAEModel) -> Path:
         "train_config": model.train_config_.to_dict(),
         "estimator": {"features": model.features, "labels": list(model.labels),
                       "holdout_every": int(model.holdout_every), "layout": model.layout,
-                      "reference_index": int(model.reference_index)},
+                      "reference_index": int(model.reference_index), "inference": str(model.inference)},
         "holdout_mask": torch.from_numpy(np.asarray(model.holdout_mask_, dtype=bool)),
         "history": [dict(h) for h in getattr(model, "history_", [])],
         "train_seconds": float(getattr(model, "train_seconds_", 0.0)),

@@ -9,6 +9,8 @@ units; :func:`evaluate_model` also reports it relative to the bounding-box diago
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
@@ -33,19 +35,24 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
     return float(err) if P.ndim == 2 else err
 
 
-def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0) -> dict:
-    """Reconstruct meshes of ``collection`` (encode to the latent mean, decode) and measure them.
+def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0,
+                   inference: str | None = None) -> dict:
+    """Reconstruct meshes of ``collection`` (encode, decode) and measure them.
 
     model : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
     indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
         collection must then be the one it was trained on).
-    fit_iterations : 0 (default) encodes with the network (the paper); k > 0 fits the latent codes
-        to the vertex positions with k Gauss-Newton steps (``MeshVAEModel.fit_latent``).
+    inference : how the codes are found (``MeshVAEModel.encode_meshes``): None, the model's own
+        (default "gauss-newton": the encoder's mean refined on the vertex error), "encoder" (the
+        paper's feed-forward encoder) or "finite-difference".
+    fit_iterations : k > 0 fits the codes by finite differences with k steps
+        (``MeshVAEModel.fit_latent``; ``meshvae evaluate --fit-latent``).
 
     Returns a dict: ``mean_vertex_error`` (float, mesh units), ``relative_error`` (mean error /
     bounding-box diagonal of each true mesh, averaged), ``n_meshes``, ``per_mesh`` (list of float),
-    ``names``, ``indices`` and ``features`` (the model's feature kind).
+    ``names``, ``indices``, ``features`` (the model's feature kind), ``inference`` (the strategy
+    used) and ``seconds_per_mesh`` (encoding and decoding).
     """
     model.check_compatible(collection)
     V = np.asarray(collection.vertices, dtype=np.float64)
@@ -66,9 +73,13 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(collection, "labels", {}) or {}).items()}
     sub = V[idx]
     lab = labels if model.is_conditional else None
-    # only pass fit_iterations when asked: a model-like object need not know the option
-    rec = model.reconstruct(sub, labels=lab, fit_iterations=fit_iterations) if fit_iterations else \
-        model.reconstruct(sub, labels=lab)
+    # only pass the options when asked: a model-like object need not know them
+    options = {"fit_iterations": fit_iterations} if fit_iterations else {}
+    if inference is not None:
+        options["inference"] = inference
+    start = time.perf_counter()
+    rec = model.reconstruct(sub, labels=lab, **options)
+    seconds = time.perf_counter() - start
     err = per_vertex_error(rec, sub)
     diag = np.atleast_1d(bounding_box_diagonal(sub))
     names = list(getattr(collection, "names", []) or [])
@@ -81,6 +92,8 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
         "indices": [int(i) for i in idx],
         "features": model.extractor_.kind,
         "fit_iterations": int(fit_iterations),
+        "inference": "finite-difference" if fit_iterations else (inference or getattr(model, "inference", "encoder")),
+        "seconds_per_mesh": seconds / idx.size,
     }
 
 

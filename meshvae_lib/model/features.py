@@ -21,7 +21,7 @@ import numpy as np
 
 from meshvae_lib.geometry.alignment import rigid_align
 
-__all__ = ["FEATURE_KINDS", "FeatureExtractor", "ConditionEncoder"]
+__all__ = ["FEATURE_KINDS", "FeatureExtractor", "CoordinateLinearization", "ConditionEncoder"]
 
 #: the feature kinds, in the order of Table 2 (baseline first).
 from meshvae_lib.defaults import FEATURE_KINDS  # noqa: E402  (re-exported: the kinds, in the order of Table 2)
@@ -155,6 +155,26 @@ class FeatureExtractor:
             V = X2.reshape(len(X2), -1, 3).copy()
         return V[0] if single else V
 
+    def linearize(self, features):
+        """The decoding of one feature row and its first-order behaviour (for latent inference).
+
+        features : (K,) float64, not normalised. Returns an object with ``positions
+        (n_vertices, 3)`` (before any alignment) and ``jvp(dF)``: ``(K, d) -> (n_vertices, 3, d)``,
+        ``vjp(dP)``: the transpose. RIMD: :meth:`RIMDReconstructor.linearize`; coordinates: the
+        reshape, exactly linear.
+        """
+        self._check_fitted()
+        f = np.asarray(features, dtype=np.float64)
+        if f.shape != (self.n_features_,):
+            raise ValueError(f"features must have shape ({self.n_features_},), got {f.shape}")
+        if self.kind != "rimd":
+            return CoordinateLinearization(f)
+        if self._reconstructor is None:
+            from meshvae_lib.geometry.reconstruction import RIMDReconstructor
+
+            self._reconstructor = RIMDReconstructor(self.reference_, self.faces_, layout=self.layout)
+        return self._reconstructor.linearize(f)
+
     # -- persistence ---------------------------------------------------------------------------
     def state_dict(self) -> dict:
         self._check_fitted()
@@ -195,6 +215,24 @@ class FeatureExtractor:
     def __repr__(self) -> str:
         extra = f", n_vertices={len(self.reference_)}, K={self.n_features_}" if hasattr(self, "reference_") else ""
         return f"FeatureExtractor(kind={self.kind!r}, layout={self.layout!r}{extra})"
+
+
+class CoordinateLinearization:
+    """Coordinate features decode by a reshape: ``positions = f.reshape(n, 3)``, exactly linear."""
+
+    def __init__(self, features: np.ndarray):
+        self.positions = features.reshape(-1, 3).copy()
+        self.positions.setflags(write=False)
+
+    def jvp(self, dF: np.ndarray) -> np.ndarray:
+        """``(3n,) -> (n, 3)`` or ``(3n, d) -> (n, 3, d)``."""
+        dF = np.asarray(dF, dtype=np.float64)
+        return dF.reshape(len(self.positions), 3, *dF.shape[1:])
+
+    def vjp(self, dP: np.ndarray) -> np.ndarray:
+        """``(n, 3) -> (3n,)`` or ``(n, 3, d) -> (3n, d)``."""
+        dP = np.asarray(dP, dtype=np.float64)
+        return dP.reshape(3 * len(self.positions), *dP.shape[2:])
 
 
 class ConditionEncoder:

@@ -6,7 +6,7 @@ the condition encoder (label names and encodings), so that applications and note
 one-liners::
 
     model = MeshVAEModel(features="rimd").fit(collection)     # or load_model("model.pt")
-    z = model.encode_meshes(collection)                      # (N, D) latent means
+    z = model.encode_meshes(collection)                      # (N, D) codes (Gauss-Newton from the encoder's means)
     meshes = model.decode_latent(z)                          # (N, n, 3)
     model.save("model.pt")                                   # the file format: model.checkpoint
 """
@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from meshvae_lib.defaults import DEFAULT_INFERENCE, GAUSS_NEWTON_ITERATIONS, INFERENCE_METHODS
 from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
 from meshvae_lib.model.normalization import FeatureNormalizer
 from meshvae_lib.model.train_config import TrainConfig
@@ -46,6 +47,11 @@ class MeshVAEModel:
         0 trains on everything.
     layout : RIMD layout ("paper" or "compact").
     reference_index : the reference mesh (default: the first mesh of the collection).
+    inference : how :meth:`encode_meshes` finds a mesh's code when a call does not say
+        (``defaults.INFERENCE_METHODS``, :mod:`~meshvae_lib.model.inference`): "gauss-newton"
+        (default: the encoder's mean, then Gauss-Newton steps on the vertex error), "encoder" (the
+        paper's feed-forward encoder), "finite-difference" (:meth:`fit_latent`). Not a training
+        setting: it can be changed on a trained model.
 
     Attributes (after :meth:`fit` or :func:`load_model`)
     ----------------------------------------------------
@@ -66,16 +72,20 @@ class MeshVAEModel:
     train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
         ``config.epochs``, or 0: the PCA initialisation itself). Not stored in checkpoints.
     selection_ : early stopping's record (see ``TrainResult.selection``) or None.
+    last_inference_ : :class:`~meshvae_lib.model.inference.GaussNewtonReport` of the latest
+        Gauss-Newton :meth:`encode_meshes` (errors before and after, steps, decodes per mesh).
     """
 
     def __init__(self, features: str = "rimd", config: TrainConfig | None = None, labels=(),
-                 holdout_every: int = 0, layout: str = "paper", reference_index: int = 0):
+                 holdout_every: int = 0, layout: str = "paper", reference_index: int = 0,
+                 inference: str = DEFAULT_INFERENCE):
         self.features = features
         self.config = config
         self.labels = tuple(labels)
         self.holdout_every = holdout_every
         self.layout = layout
         self.reference_index = reference_index
+        self.inference = inference
 
     # -- training ------------------------------------------------------------------------------
     def fit(self, collection) -> "MeshVAEModel":
@@ -175,22 +185,52 @@ class MeshVAEModel:
         self._check_fitted()
         return self.normalizer_.transform(self.extractor_.transform(vertices))
 
-    @torch.no_grad()
-    def encode_meshes(self, vertices, conditions=None, labels=None, return_sigma: bool = False):
-        """Latent means (N, D) float64 of meshes (N, n, 3) or of a collection.
+    def encode_meshes(self, vertices, conditions=None, labels=None, return_sigma: bool = False,
+                      inference: str | None = None, iterations: int = GAUSS_NEWTON_ITERATIONS, progress: bool = False):
+        """Latent codes (N, D) float64 of meshes (N, n, 3) or of a collection.
+
+        inference : "gauss-newton" | "encoder" | "finite-difference", or None for the model's own
+            (``self.inference``, default "gauss-newton"); see :mod:`~meshvae_lib.model.inference`.
+            "encoder" gives the paper's posterior means; the others start there and fit the code
+            to the vertex positions (any rigid pose), never ending worse than the encoder's mean.
+        iterations : Gauss-Newton steps per mesh for the fitting strategies (>= 1).
+        progress : a progress bar over the meshes (fitting strategies).
 
         For a conditional model give ``conditions (N, C)`` or ``labels`` (dict column -> (N,));
         a collection's own labels are used when neither is given. With ``return_sigma`` also the
-        posterior deviations (N, D).
+        encoder's posterior deviations (N, D).
         """
         self._check_fitted()
+        method = self.inference if inference is None else inference
+        if method not in INFERENCE_METHODS:
+            raise ValueError(f"inference must be one of {INFERENCE_METHODS}, got {method!r}")
         if labels is None and conditions is None and hasattr(vertices, "labels"):
             labels = vertices.labels if self.is_conditional else None
+        mu, sigma = self._encoder_means(vertices, conditions, labels)
+        if method == "gauss-newton":
+            from meshvae_lib.model.inference import gauss_newton_codes
+
+            if iterations < 1:
+                raise ValueError(f"iterations must be >= 1, got {iterations}")
+            C = self._conditions(len(mu), conditions, labels)
+            mu, self.last_inference_ = gauss_newton_codes(
+                self, self._vertex_array(vertices), mu, None if C is None else C.double().numpy(),
+                iterations=iterations, progress=progress)
+        elif method == "finite-difference":
+            mu = self.fit_latent(vertices, iterations=iterations, z0=mu, conditions=conditions, labels=labels)
+        return (mu, sigma) if return_sigma else mu
+
+    @staticmethod
+    def _vertex_array(vertices) -> np.ndarray:
+        V = np.asarray(getattr(vertices, "vertices", vertices), dtype=np.float64)
+        return V[None] if V.ndim == 2 else V
+
+    @torch.no_grad()
+    def _encoder_means(self, vertices, conditions, labels) -> tuple[np.ndarray, np.ndarray]:
         X = self.features_of(vertices)
         x = torch.from_numpy(X.astype(np.float32))
         mu, sigma = self.network_.eval().encode(x, self._conditions(len(X), conditions, labels))
-        mu = mu.double().numpy()
-        return (mu, sigma.double().numpy()) if return_sigma else mu
+        return mu.double().numpy(), sigma.double().numpy()
 
     @torch.no_grad()
     def decode_latent(self, z, conditions=None, labels=None) -> np.ndarray:
@@ -208,17 +248,21 @@ class MeshVAEModel:
         V = self.extractor_.inverse_transform(self.normalizer_.inverse_transform(rows))
         return V[0] if single else V
 
-    def reconstruct(self, vertices, conditions=None, labels=None, fit_iterations: int = 0) -> np.ndarray:
-        """Encode to the latent means and decode: meshes (N, n, 3) -> (N, n, 3) float64.
+    def reconstruct(self, vertices, conditions=None, labels=None, fit_iterations: int = 0,
+                    inference: str | None = None) -> np.ndarray:
+        """Encode (:meth:`encode_meshes`, the model's inference unless ``inference`` says) and
+        decode: meshes (N, n, 3) -> (N, n, 3) float64.
 
-        ``fit_iterations > 0``: then refine the codes on the vertex positions (:meth:`fit_latent`).
+        ``fit_iterations > 0``: the finite-difference fit with that many steps (:meth:`fit_latent`;
+        the same as ``inference="finite-difference"``, kept for ``meshvae evaluate --fit-latent``).
         """
         if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
             labels = vertices.labels
         if fit_iterations:
-            z = self.fit_latent(vertices, iterations=fit_iterations, conditions=conditions, labels=labels)
+            z = self.encode_meshes(vertices, conditions, labels, inference="finite-difference",
+                                   iterations=fit_iterations)
         else:
-            z = self.encode_meshes(vertices, conditions, labels)
+            z = self.encode_meshes(vertices, conditions, labels, inference=inference)
         return self.decode_latent(z, conditions, labels)
 
     def fit_latent(self, vertices, iterations: int = 3, z0=None, conditions=None, labels=None,
@@ -246,7 +290,8 @@ class MeshVAEModel:
             labels = vertices.labels
         V = np.asarray(getattr(vertices, "vertices", vertices), dtype=np.float64)
         V = V[None] if V.ndim == 2 else V
-        Z = np.array(self.encode_meshes(V, conditions, labels) if z0 is None else z0, dtype=np.float64)
+        Z = np.array(self.encode_meshes(V, conditions, labels, inference="encoder") if z0 is None else z0,
+                     dtype=np.float64)
         if Z.shape != (len(V), self.network_.latent_dim):
             raise ValueError(f"z0 must have shape ({len(V)}, {self.network_.latent_dim}), got {Z.shape}")
         C = None

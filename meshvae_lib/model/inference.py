@@ -1,0 +1,261 @@
+"""Latent inference: which code z a trained mesh VAE gives a mesh.
+
+Three strategies, by name (``defaults.INFERENCE_METHODS``; ``MeshVAEModel(inference=...)`` picks
+the model's default, ``encode_meshes(..., inference=...)`` one call's):
+
+- ``"encoder"``: the paper's amortised inference, the encoder's mean ``mu(x)`` of the mesh's
+  normalised features. One matrix product; on real collections it spends its code on feature
+  directions that barely move the vertices (docs/vae.md, "Why the encoder falls short").
+- ``"gauss-newton"`` (default): semi-amortised inference. Start at the encoder's mean, then take
+  a few damped Gauss-Newton (Levenberg-Marquardt) steps on the decoded mesh's squared vertex
+  error, ``min_z min_(R,t) sum_k |decode(z)_k - (R x_k + t)|^2``, with the **analytic** Jacobian
+  of decoder and reconstruction: :func:`decoder_jacobian` (the network, then the affine maps of
+  the output range and Eq. 3) times the feature kind's linearisation
+  (:meth:`FeatureExtractor.linearize`, for RIMD
+  :mod:`~meshvae_lib.geometry.reconstruction_linearization`). One step costs one Jacobian (two
+  factorised sparse solves per latent dimension) and usually one decode.
+- ``"finite-difference"``: the same objective with undamped steps and a Jacobian by forward
+  differences (D + 1 decodes per step; ``MeshVAEModel.fit_latent``). Kept as a reference.
+
+The rigid motion is eliminated by projecting the six rigid vertex fields (three translations,
+three rotations about the centroid) out of the Jacobian and aligning the target to each decoded
+mesh; the model's decoder, normaliser and reconstruction are not changed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from meshvae_lib import tolerances as tol
+from meshvae_lib.geometry.alignment import rigid_align
+from meshvae_lib.model.training import from_output_range
+
+__all__ = ["decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes"]
+
+
+def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The output activation and its slope, in float64."""
+    if network.output == "sigmoid":
+        r = 1.0 / (1.0 + np.exp(-y))
+        return r, r * (1.0 - r)
+    r = np.tanh(y)
+    return r, 1.0 - r * r
+
+
+def decoder_jacobian(network, z: np.ndarray, c: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The network's decoded rows and their Jacobian with respect to the code.
+
+    Parameters
+    ----------
+    network : MeshVAE (in eval mode: batch normalisation is then affine)
+    z : (D,) float
+        One latent code.
+    c : (C,) float or None
+        Its condition vector (conditional networks).
+
+    Returns
+    -------
+    rows : (K,) float64
+        ``network.decode(z, c)`` (in the network's output range).
+    J : (K, D) float64
+        ``d rows / d z = act'(y) W dh/dz`` with ``y = W h + b`` the output layer and ``h`` its
+        input: ``[z, c]`` without hidden layers (closed form, float64), else the hidden layers'
+        output, whose small Jacobian comes from torch's autograd.
+    """
+    D = network.latent_dim
+    z = np.asarray(z, dtype=np.float64).reshape(D)
+    W = network.decoder_head.weight.detach().double().numpy()
+    b = network.decoder_head.bias.detach().double().numpy()
+    if not network.hidden:
+        y = W[:, :D] @ z + b
+        if network.n_conditions:
+            y = y + W[:, D:] @ np.asarray(c, dtype=np.float64).reshape(network.n_conditions)
+        rows, slope = _activate(network, y)
+        return rows, slope[:, None] * W[:, :D]
+    ct = None if c is None else torch.from_numpy(np.asarray(c, dtype=np.float32).reshape(1, -1))
+
+    def body(v):
+        return network.decoder_body(network._with_condition(v[None], ct, D, "latent vectors"))[0]
+
+    zt = torch.from_numpy(z.astype(np.float32))
+    with torch.no_grad():
+        h = body(zt).double().numpy()
+    Jh = torch.autograd.functional.jacobian(body, zt).double().numpy()     # (width, D)
+    rows, slope = _activate(network, W @ h + b)
+    return rows, slope[:, None] * (W @ Jh)
+
+
+def rigid_fields(P: np.ndarray) -> np.ndarray:
+    """Orthonormal basis of the rigid motions' vertex fields at a mesh.
+
+    Parameters
+    ----------
+    P : (n_vertices, 3) float64
+
+    Returns
+    -------
+    Q : (3 n_vertices, 6) float64
+        Columns spanning the three translations and the three infinitesimal rotations about the
+        centroid (flattened row-major like ``P.ravel()``), orthonormalised.
+    """
+    n = len(P)
+    q = P - P.mean(axis=0)
+    A = np.zeros((n, 3, 6))
+    A[:, 0, 0] = A[:, 1, 1] = A[:, 2, 2] = 1.0
+    A[:, 1, 3], A[:, 2, 3] = q[:, 2], -q[:, 1]
+    A[:, 0, 4], A[:, 2, 4] = -q[:, 2], q[:, 0]
+    A[:, 0, 5], A[:, 1, 5] = q[:, 1], -q[:, 0]
+    Q, _ = np.linalg.qr(A.reshape(3 * n, 6))
+    return Q
+
+
+class GaussNewtonReport:
+    """What :func:`gauss_newton_codes` did, per mesh.
+
+    Attributes
+    ----------
+    initial_error, final_error : (N,) float64
+        Mean vertex distance (after the best rigid motion) at the starting code and at the result.
+    iterations : (N,) int64
+        Jacobians computed (accepted or not).
+    decodes : (N,) int64
+        Decodes (reconstructions) made, the starting one included.
+    """
+
+    def __init__(self, n: int):
+        self.initial_error = np.zeros(n)
+        self.final_error = np.zeros(n)
+        self.iterations = np.zeros(n, np.int64)
+        self.decodes = np.zeros(n, np.int64)
+
+    def __repr__(self) -> str:
+        return (f"GaussNewtonReport(n={len(self.iterations)}, mean error {self.initial_error.mean():.4g}"
+                f" -> {self.final_error.mean():.4g}, iterations {self.iterations.mean():.1f}/mesh)")
+
+
+class _Decoder:
+    """Codes -> features and their Jacobian for one model, with the network's weights converted once."""
+
+    def __init__(self, model, conditions: np.ndarray | None):
+        net = model.network_
+        self.model, self.network, self.conditions = model, net, conditions
+        K, D = net.n_features, net.latent_dim
+
+        def to_features(r):
+            return model.normalizer_.inverse_transform(from_output_range(r, model.normalizer_.a, net.output))
+
+        # rows -> features is affine per column (the output range, then Eq. 3 inverted)
+        self.offset = np.asarray(to_features(np.zeros((1, K))), dtype=np.float64)[0]
+        self.scale = np.asarray(to_features(np.ones((1, K))), dtype=np.float64)[0] - self.offset
+        if net.hidden:
+            self.used = np.arange(D)
+            return
+        W = net.decoder_head.weight.detach().double().numpy()
+        # a PCA-started decoder leaves the dimensions beyond the data's rank at exactly 0
+        size = np.abs(W[:, :D]).max(axis=0)
+        self.used = np.flatnonzero(size > tol.GN_UNUSED_DIM_RTOL * size.max())
+        self.W = np.ascontiguousarray(W[:, self.used])
+        self.b = net.decoder_head.bias.detach().double().numpy()
+        self.Wc = W[:, D:]
+
+    def rows(self, z: np.ndarray, c) -> tuple[np.ndarray, np.ndarray | None]:
+        """Network rows (K,) float64 and, without hidden layers, the output's slope (K,)."""
+        if self.network.hidden:
+            rows, self._J = decoder_jacobian(self.network, z, c)
+            return rows, None
+        y = self.W @ z[self.used] + self.b
+        if self.network.n_conditions:
+            y = y + self.Wc @ np.asarray(c, dtype=np.float64)
+        return _activate(self.network, y)
+
+    def state(self, z: np.ndarray, c, x: np.ndarray) -> "_DecodedState":
+        rows, slope = self.rows(z, c)
+        return _DecodedState(self, self.offset + self.scale * rows, slope, x)
+
+    def feature_jacobian(self, state: "_DecodedState") -> np.ndarray:
+        """d features / d z[used]: (K, n_used) float64."""
+        if self.network.hidden:
+            return self.scale[:, None] * state.network_jacobian[:, self.used]
+        return (self.scale * state.slope)[:, None] * self.W
+
+
+class _DecodedState:
+    """A decoded code: positions before alignment, the residual to the target, the linearisation."""
+
+    def __init__(self, decoder: _Decoder, features: np.ndarray, slope, x: np.ndarray):
+        self.slope = slope
+        self.network_jacobian = getattr(decoder, "_J", None)
+        self.lin = decoder.model.extractor_.linearize(features)
+        P = self.lin.positions
+        self.residual = rigid_align(x, P) - P                      # (n, 3): target moved onto P
+        self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
+        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
+
+
+def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: np.ndarray | None = None,
+                       iterations: int = 4, progress: bool = False) -> tuple[np.ndarray, GaussNewtonReport]:
+    """Codes fitted to vertex positions by damped Gauss-Newton with the analytic Jacobian.
+
+    Parameters
+    ----------
+    model : fitted MeshVAEModel
+    vertices : (N, n_vertices, 3) float64
+        The meshes to encode (any rigid pose).
+    z0 : (N, D) float64
+        Starting codes (the encoder's means).
+    conditions : (N, C) float or None
+        Condition vectors of a conditional model (held fixed).
+    iterations : int >= 1
+        Jacobians per mesh at most; each is followed by up to ``GN_MAX_TRIES`` damped steps until
+        one lowers the squared vertex error (the fit stops when none does, or when the decrease is
+        below ``GN_REL_DECREASE``).
+    progress : show a progress bar.
+
+    Returns
+    -------
+    Z : (N, D) float64
+        Never worse than ``z0`` in the vertex error (a step is only taken when it lowers it).
+    report : GaussNewtonReport
+    """
+    from meshvae_lib.progress import progress as progress_bar
+
+    V = np.asarray(vertices, dtype=np.float64)
+    Z = np.array(z0, dtype=np.float64)
+    report = GaussNewtonReport(len(V))
+    decoder = _Decoder(model, conditions)
+    used = decoder.used
+    meshes = progress_bar(range(len(V)), desc="fitting codes", unit="mesh", disable=not progress)
+    for j in meshes:
+        c = None if conditions is None else conditions[j]
+        state = decoder.state(Z[j], c, V[j])
+        report.initial_error[j], report.decodes[j] = state.mean_error, 1
+        damping = tol.GN_DAMPING_START
+        for _ in range(int(iterations)):
+            report.iterations[j] += 1
+            n = state.residual.shape[0]
+            J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(3 * n, len(used))
+            Q = rigid_fields(state.lin.positions)
+            J = J - Q @ (Q.T @ J)
+            H = J.T @ J
+            g = J.T @ state.residual.ravel()
+            mean_diag = float(np.trace(H)) / len(used)
+            accepted = None
+            for _ in range(tol.GN_MAX_TRIES):
+                z_new = Z[j].copy()
+                z_new[used] += np.linalg.solve(H + damping * mean_diag * np.eye(len(used)), g)
+                trial = decoder.state(z_new, c, V[j])
+                report.decodes[j] += 1
+                if trial.sq_error < state.sq_error:
+                    accepted = (z_new, trial)
+                    damping = max(damping * tol.GN_DAMPING_DOWN, tol.GN_DAMPING_FLOOR)
+                    break
+                damping *= tol.GN_DAMPING_UP
+            if accepted is None:
+                break
+            decrease = 1.0 - accepted[1].sq_error / state.sq_error
+            Z[j], state = accepted
+            if decrease < tol.GN_REL_DECREASE:
+                break
+        report.final_error[j] = state.mean_error
+    return Z, report
