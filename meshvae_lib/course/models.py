@@ -36,11 +36,12 @@ logger = logging.getLogger(__name__)
 #: environment variable that overrides the cache folder.
 CACHE_ENV = "MESHVAE_CACHE"
 
-#: the parts of meshvae_lib whose source does not determine a trained model: the applications and
-#: the evaluation (they use a model, not train it), the paper's experiments (their own models), the
-#: viewers, the command line and this course layer. Everything else,
-#: and all of data_synth, is in the key.
-_CODE_EXCLUDED = ("applications", "paper", "viewing", "cli", "course", "model/evaluation.py")
+#: the parts of meshvae_lib whose source does not determine a trained model: the applications, the
+#: evaluation and the latent inference with the reconstruction's linearisation (they use a model,
+#: not train it), the paper's experiments (their own models), the viewers, the command line and
+#: this course layer. Everything else, and all of data_synth, is in the key.
+_CODE_EXCLUDED = ("applications", "paper", "viewing", "cli", "course", "model/evaluation.py", "model/inference.py",
+                  "geometry/reconstruction_linearization.py")
 
 
 @dataclass(frozen=True)
