@@ -130,21 +130,20 @@ class RIMDReconstructor:
         Raises
         ------
         ValueError
-            For the BFS rotation recovery or the paper's local-global iterations, which are not
-            linearised (the exact method with global rotations, the default, is).
+            For the paper's local-global iterations (``method="paper"``, ``iterations > 0``), which
+            are not differentiated.
         """
-        if self.rotations != "global" or (self.method == "paper" and self.iterations):
-            raise ValueError("linearize needs rotations='global' and no local-global iterations, got "
-                             f"rotations={self.rotations!r}, method={self.method!r}, iterations={self.iterations}")
+        if self.method == "paper" and self.iterations:
+            raise ValueError(f"linearize does not differentiate the paper's local-global iterations, got {self.iterations}")
         f = check_finite(self.layout.check_features(features), "features")
         if f.ndim != 1:
             raise ValueError(f"linearize takes one feature vector ({self.layout.K},), got {f.shape}")
         log_dR, S = self.layout.unpack(f)
         w = np.ascontiguousarray(log_dR[0].T)
         Ssoa = np.ascontiguousarray(S[0].reshape(self.n_vertices, 9).T)
-        R = self._rotation_recovery(w)
+        R, record = self._rotation_recovery.recover(w)
         P = self._positions(matmul_soa(R, Ssoa))
-        return ReconstructionLinearization(self, w, Ssoa, R, P)
+        return ReconstructionLinearization(self, w, Ssoa, R, P, record)
 
     def recover_rotations(self, log_dR) -> np.ndarray:
         """Per-vertex rotations from edge rotation vectors, up to one global rotation.

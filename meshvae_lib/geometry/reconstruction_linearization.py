@@ -15,20 +15,21 @@ derivative. For a perturbation ``df`` of the feature:
    ``eta_e = J_r(w_e) dw_e`` in its own frame (``J_r``: the right Jacobian of the SO(3)
    exponential), where ``dw_e`` is the change of the edge's rotation vector (for the paper layout
    the mean of its two stored directions, as :meth:`RIMDLayout.unpack` takes it);
-2. the rotation synchronisation responds with global-frame increments ``g_i``
-   (``R_i <- exp(hat(g_i)) R_i``). Where the edge rotations are consistent (``R_i dR_ij = R_j``)
-   its least-squares optimality condition is linear with the fixed graph Laplacian its sweeps
-   already factorise: ``L g = G^T rho`` with ``rho_e = R_j eta_e``;
+2. the recovered rotations turn by global-frame increments ``g_i`` (``R_i <- exp(hat(g_i)) R_i``):
+   :meth:`RotationRecovery.linear_response` differentiates the steps the recovery actually took
+   (the breadth-first walk, then each Gauss-Newton sweep of the synchronisation, whose matrix is the
+   graph Laplacian factorised once), so the derivative is exact also where a decoder's features are
+   not consistent and the sweeps stop before the least-squares optimum;
 3. ``T_i = R_i S_i`` changes by ``dT_i = hat(g_i) T_i + R_i dS_i``, and the positions by the
    position solve of ``dT`` -- again a fixed, factorised matrix.
 
-So a Jacobian-vector product costs two sparse solves with already-factorised matrices, and the
-adjoint the same two solves in reverse order (the matrices are symmetric). Decoded features are
-close to, not exactly, consistent; the formula of step 2 then describes the synchronisation to
-first order only. Measured on a real 10k-vertex performance capture at a decoder's output: within
-0.1-0.3% of forward differences of the reconstruction. The exact solver's optional Gauss-Newton
-refinement (active only for meshes with perfectly symmetric one-rings, ``refine_active``) is not
-differentiated: it changes positions by ~1e-5 of the diagonal.
+So a Jacobian-vector product costs one sparse solve per synchronisation sweep taken (0 to 3) plus
+one position solve, all with already-factorised matrices, and the adjoint the same solves in
+reverse order (the matrices are symmetric). Matches central differences of the reconstruction to
+the differences' own accuracy (``tests/test_inference.py``). Not differentiated: the exact solver's
+optional Gauss-Newton refinement (active only for meshes with perfectly symmetric one-rings,
+``refine_active``), which changes positions by ~1e-5 of the diagonal, and the sweeps' stopping
+decisions (piecewise constant).
 """
 
 from __future__ import annotations
@@ -36,9 +37,9 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib.geometry.rimd import S_ENTRIES
-from meshvae_lib.geometry.rotations import matmul_soa
+from meshvae_lib.geometry.rotations import matmul_soa, right_jacobian
 
-__all__ = ["ReconstructionLinearization", "right_jacobian_soa"]
+__all__ = ["ReconstructionLinearization"]
 
 #: ``hat(e_k)`` for the unit vectors e_0, e_1, e_2.
 _GENERATORS = np.zeros((3, 3, 3))
@@ -50,30 +51,6 @@ _S6_TO_9 = np.zeros((9, 6))
 for _k, (_a, _b) in enumerate(S_ENTRIES):
     _S6_TO_9[3 * _a + _b, _k] = 1.0
     _S6_TO_9[3 * _b + _a, _k] = 1.0
-
-
-def right_jacobian_soa(w: np.ndarray) -> np.ndarray:
-    """Right Jacobians of the SO(3) exponential: ``exp(hat(w + d)) ~ exp(hat(w)) exp(hat(J_r(w) d))``.
-
-    Parameters
-    ----------
-    w : (m, 3) float64
-        Rotation vectors.
-
-    Returns
-    -------
-    J : (m, 3, 3) float64
-        ``J_r(w) = I - (1 - cos t) / t^2 hat(w) + (t - sin t) / t^3 hat(w)^2``, ``t = |w|``
-        (series below 1e-4 rad).
-    """
-    w = np.asarray(w, dtype=np.float64)
-    t = np.sqrt(np.einsum("mi,mi->m", w, w))
-    small = t < 1e-4
-    ts = np.where(small, 1.0, t)
-    a = np.where(small, 0.5 - t ** 2 / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
-    b = np.where(small, 1.0 / 6.0 - t ** 2 / 120.0, (ts - np.sin(ts)) / ts ** 3)
-    W = np.einsum("mk,kab->mab", w, _GENERATORS)
-    return np.eye(3) - a[:, None, None] * W + b[:, None, None] * (W @ W)
 
 
 class ReconstructionLinearization:
@@ -89,7 +66,8 @@ class ReconstructionLinearization:
         K of the layout.
     """
 
-    def __init__(self, reconstructor, w: np.ndarray, S: np.ndarray, R: np.ndarray, positions: np.ndarray):
+    def __init__(self, reconstructor, w: np.ndarray, S: np.ndarray, R: np.ndarray, positions: np.ndarray,
+                 record: dict):
         layout = reconstructor.layout
         n = layout.n_vertices
         self._layout = layout
@@ -100,8 +78,9 @@ class ReconstructionLinearization:
         self.n_features = int(layout.K)
         Rm = np.ascontiguousarray(R.T).reshape(n, 3, 3)
         Tm = np.ascontiguousarray(matmul_soa(R, S).T).reshape(n, 3, 3)
-        # edge e = (i, j): d(edge rotation vector) -> rho_e = R_j J_r(w_e) dw_e
-        self._edge_map = Rm[layout.edges[:, 1]] @ right_jacobian_soa(np.ascontiguousarray(w.T))
+        self._record = record
+        # edge e: d(edge rotation vector) -> its body-frame turn eta_e = J_r(w_e) dw_e
+        self._edge_map = right_jacobian(np.ascontiguousarray(w.T))
         # g_i -> dT_i = hat(g_i) T_i, as (9, 3) per vertex; dS6_i -> R_i dS_i, as (9, 6)
         self._g_map = np.einsum("kac,ncb->nabk", _GENERATORS, Tm).reshape(n, 9, 3)
         self._s_map = np.einsum("nac,cbk->nabk", Rm, _S6_TO_9.reshape(3, 3, 6)).reshape(n, 9, 6)
@@ -149,7 +128,7 @@ class ReconstructionLinearization:
         if dF.ndim != 2 or dF.shape[0] != self.n_features:
             raise ValueError(f"dF must have shape ({self.n_features},) or ({self.n_features}, d), got {dF.shape}")
         dw, dS6 = self._split(dF)
-        g = self._rotations.linear_response(self._edge_map @ dw)           # (n, 3, d)
+        g = self._rotations.linear_response(self._record, self._edge_map @ dw)   # (n, 3, d)
         dT = self._g_map @ g + self._s_map @ dS6                          # (n, 9, d)
         dP = self._positions_solver.solve_gradients(dT)                   # (n, 3, d)
         return dP[:, :, 0] if single else dP
@@ -174,7 +153,7 @@ class ReconstructionLinearization:
         dT_adj = self._positions_solver.solve_gradients_adjoint(dP)        # (n, 9, d)
         g_adj = self._g_map.transpose(0, 2, 1) @ dT_adj                  # (n, 3, d)
         dS6_adj = self._s_map.transpose(0, 2, 1) @ dT_adj                 # (n, 6, d)
-        rho_adj = self._rotations.linear_response_adjoint(g_adj)          # (E, 3, d)
-        dw_adj = self._edge_map.transpose(0, 2, 1) @ rho_adj
+        eta_adj = self._rotations.linear_response_adjoint(self._record, g_adj)   # (E, 3, d)
+        dw_adj = self._edge_map.transpose(0, 2, 1) @ eta_adj
         dF = self._join(dw_adj, dS6_adj)
         return dF[:, 0] if single else dF

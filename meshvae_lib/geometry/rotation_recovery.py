@@ -28,7 +28,7 @@ from scipy.sparse import csgraph
 from meshvae_lib import tolerances as tol
 from meshvae_lib.defaults import ROTATION_RECOVERY
 from meshvae_lib.geometry.rotations import (
-    exp_soa, matmul_soa, quat_exp_soa, quat_from_soa, quat_mul_soa)
+    exp_soa, matmul_soa, quat_exp_soa, quat_from_soa, quat_mul_soa, right_jacobian)
 from meshvae_lib.geometry.sparse_lu import factorize_spd, pinning, solve_columns
 from meshvae_lib.geometry.topology import edge_index
 from meshvae_lib.validation import check_choice
@@ -156,7 +156,7 @@ class RotationRecovery:
             R[lv] = R[self._parent[lv]] @ dm[lv]
         return np.ascontiguousarray(R.reshape(n, 9).T)
 
-    def synchronize(self, R: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, int]:
+    def synchronize(self, R: np.ndarray, w: np.ndarray, steps: list | None = None) -> tuple[np.ndarray, int]:
         """Global Gauss-Newton sweeps on all edges.
 
         The residual of edge (i, j) is the axial vector of ``D = R_i dR_ij R_j^T`` (``sin`` of the
@@ -169,6 +169,10 @@ class RotationRecovery:
             Starting rotations (the BFS walk).
         w : (3, n_edges) float64
             ``log dR_ij`` of the undirected edges.
+        steps : list or None
+            If given, each applied correction is appended as ``(R before it (9, n), omega (n, 3))``
+            (what :meth:`linear_response` differentiates), and a zero correction where the edges
+            were consistent (any perturbation makes that sweep run).
 
         Returns
         -------
@@ -186,10 +190,17 @@ class RotationRecovery:
             qj[1:] *= -1.0  # conjugate
             d = quat_mul_soa(a, qj)
             delta = 2.0 * d[0] * d[1:]  # (3, E)
-            if sweeps == tol.ROTATION_SYNC_MAX_SWEEPS or (
-                    np.max(np.abs(delta)) < tol.ROTATION_SYNC_TOL):
+            if sweeps == tol.ROTATION_SYNC_MAX_SWEEPS:
+                break
+            if np.max(np.abs(delta)) < tol.ROTATION_SYNC_TOL:
+                if steps is not None:
+                    # consistent edges: nothing to correct here, but any perturbation makes this
+                    # sweep run, so the derivative includes it (with a zero correction)
+                    steps.append((R, np.zeros((self.n_vertices, 3))))
                 break
             omega = self._sync_lu.solve(np.ascontiguousarray(self._Gt @ delta.T))  # (n, 3)
+            if steps is not None:
+                steps.append((R, omega))
             R = matmul_soa(exp_soa(np.ascontiguousarray(omega.T)), R)
             if np.max(np.abs(omega)) < tol.ROTATION_SYNC_STEP_TOL:
                 sweeps += 1
@@ -199,34 +210,89 @@ class RotationRecovery:
     def __call__(self, w: np.ndarray) -> np.ndarray:
         """Rotations ``(9, n_vertices)`` from ``log dR_ij`` ``(3, n_edges)``: the walk, then (for
         ``"global"``) the sweeps."""
+        return self.recover(w)[0]
+
+    def recover(self, w: np.ndarray) -> tuple[np.ndarray, dict]:
+        """:meth:`__call__` and a record of its steps for :meth:`linear_response`: ``(R (9, n),
+        {"w", "bfs": the walk's R (9, n), "steps": [(R, omega), ...]})``."""
         R = self.bfs(w)
+        record = {"w": w, "bfs": R, "steps": []}
         if self.method == "global":
-            R, sweeps = self.synchronize(R, w)
+            R, sweeps = self.synchronize(R, w, record["steps"])
             logger.debug("rotation sync: %d sweeps", sweeps)
-        return R
+        return R, record
 
     # -- first-order response (geometry.reconstruction_linearization) -------------------------
-    def linear_response(self, rho: np.ndarray) -> np.ndarray:
-        """Global-frame rotation increments ``g`` for edge-rotation changes ``rho``.
+    def _edge_terms(self, R: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """At rotations R (9, n): ``R`` as (n, 3, 3) and, per edge, the matrices that map a global
+        rotation of ``R_i`` / of ``R_j dR_ij^-1`` to the change of the residual
+        ``vee(skew(D))``, ``D = R_i dR_ij R_j^T``: ``(tr D I - D) / 2`` and ``(tr D I - D^T) / 2``."""
+        n, E = self.n_vertices, self.edges
+        Rm = np.ascontiguousarray(R.T).reshape(n, 3, 3)
+        dR = np.ascontiguousarray(exp_soa(w).T).reshape(-1, 3, 3)
+        D = Rm[E[:, 0]] @ dR @ Rm[E[:, 1]].transpose(0, 2, 1)
+        tr = np.trace(D, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+        return Rm, 0.5 * (tr - D), 0.5 * (tr - D.transpose(0, 2, 1))
 
-        Where the edge rotations are consistent (``R_i dR_ij = R_j``), the synchronisation's
-        least-squares optimality condition is linear with the factorised graph Laplacian:
-        ``L g = G^T rho``, ``R_i <- exp(hat(g_i)) R_i``.
+    def linear_response(self, record: dict, eta: np.ndarray) -> np.ndarray:
+        """Global-frame changes ``g`` of the recovered rotations (``R_i <- exp(hat(g_i)) R_i``) for
+        body-frame changes ``eta`` of the edge rotations (``dR_ij <- dR_ij exp(hat(eta_ij))``),
+        through the steps :meth:`recover` took: the walk, ``g_child = g_parent + R_child eta``
+        (``- R_parent eta`` for edges walked against their order), then each sweep: the residual
+        ``delta_ij = vee(skew(R_i dR_ij R_j^T))`` changes by ``M_l g_i + M_r (R_j eta_ij - g_j)``, the
+        correction ``omega = L^-1 G^T delta`` by ``L^-1 G^T d(delta)`` (the factorised Laplacian) and
+        ``exp(hat(omega)) R`` by ``g <- J_l(omega) d(omega) + exp(hat(omega)) g``.
 
         Parameters
         ----------
-        rho : (n_edges, 3, d) float64
-            Per edge, the change of ``R_j``'s direction requested by the edge, in the global frame.
+        record : the dict of :meth:`recover`.
+        eta : (n_edges, 3, d) float64
 
         Returns
         -------
         g : (n_vertices, 3, d) float64
         """
-        E, _, d = rho.shape
-        return solve_columns(self._sync_lu, self._Gt @ rho.reshape(E, 3 * d)).reshape(self.n_vertices, 3, d)
+        n, (E, _, d) = self.n_vertices, eta.shape
+        Rb = np.ascontiguousarray(record["bfs"].T).reshape(n, 3, 3)
+        child = np.flatnonzero(self._parent >= 0)
+        u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
+        c = np.zeros((n, 3, d))
+        c[child] = np.where(flip[:, None, None], -(Rb[par] @ eta[u]), Rb[child] @ eta[u])
+        g = np.zeros((n, 3, d))
+        for lv in self._levels[1:]:
+            g[lv] = g[self._parent[lv]] + c[lv]
+        E0, E1 = self.edges[:, 0], self.edges[:, 1]
+        for R, omega in record["steps"]:
+            Rm, Ml, Mr = self._edge_terms(R, record["w"])
+            dd = Ml @ g[E0] + Mr @ (Rm[E1] @ eta - g[E1])
+            dw = solve_columns(self._sync_lu, self._Gt @ dd.reshape(E, 3 * d)).reshape(n, 3, d)
+            g = right_jacobian(-omega) @ dw + np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3) @ g
+        return g
 
-    def linear_response_adjoint(self, g_adj: np.ndarray) -> np.ndarray:
+    def linear_response_adjoint(self, record: dict, g_adj: np.ndarray) -> np.ndarray:
         """The transpose of :meth:`linear_response`: ``(n_vertices, 3, d) -> (n_edges, 3, d)``."""
-        n, _, d = g_adj.shape
-        mu = solve_columns(self._sync_lu, g_adj.reshape(n, 3 * d))   # the Laplacian is symmetric
-        return (self._G @ mu).reshape(-1, 3, d)
+        n, d = self.n_vertices, g_adj.shape[2]
+        E = len(self.edges)
+        E0, E1 = self.edges[:, 0], self.edges[:, 1]
+        eta_adj = np.zeros((E, 3, d))
+        g = np.array(g_adj, dtype=np.float64)
+        for R, omega in reversed(record["steps"]):
+            Rm, Ml, Mr = self._edge_terms(R, record["w"])
+            Ex = np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3)
+            dw_adj = right_jacobian(-omega).transpose(0, 2, 1) @ g
+            g = Ex.transpose(0, 2, 1) @ g
+            b = solve_columns(self._sync_lu, dw_adj.reshape(n, 3 * d))     # the Laplacian is symmetric
+            dd_adj = (self._G @ b).reshape(E, 3, d)
+            np.add.at(g, E0, Ml.transpose(0, 2, 1) @ dd_adj)
+            r_adj = Mr.transpose(0, 2, 1) @ dd_adj
+            np.add.at(g, E1, -r_adj)
+            eta_adj += Rm[E1].transpose(0, 2, 1) @ r_adj
+        Rb = np.ascontiguousarray(record["bfs"].T).reshape(n, 3, 3)
+        for lv in reversed(self._levels[1:]):
+            np.add.at(g, self._parent[lv], g[lv])
+        child = np.flatnonzero(self._parent >= 0)
+        u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
+        contrib = np.where(flip[:, None, None], -(Rb[par].transpose(0, 2, 1) @ g[child]),
+                           Rb[child].transpose(0, 2, 1) @ g[child])
+        np.add.at(eta_adj, u, contrib)
+        return eta_adj

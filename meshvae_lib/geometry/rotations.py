@@ -28,6 +28,7 @@ from meshvae_lib.validation import check_matrices, check_vectors
 
 __all__ = [
     "hat",
+    "right_jacobian",
     "vee",
     "so3_log",
     "so3_exp",
@@ -313,3 +314,30 @@ def quat_mul_soa(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         aw * by - ax * bz + ay * bw + az * bx,
         aw * bz + ax * by - ay * bx + az * bw,
     ])
+
+
+def right_jacobian(w: np.ndarray) -> np.ndarray:
+    """Right Jacobians of the SO(3) exponential: ``exp(hat(w + d)) ~ exp(hat(w)) exp(hat(J_r(w) d))``.
+
+    Parameters
+    ----------
+    w : (m, 3) float64
+        Rotation vectors.
+
+    Returns
+    -------
+    J : (m, 3, 3) float64
+        ``J_r(w) = I - (1 - cos t) / t^2 hat(w) + (t - sin t) / t^3 hat(w)^2``, ``t = |w|`` (series
+        below ``SO3_SMALL_ANGLE``). The left Jacobian is ``J_r(-w) = J_r(w)^T``.
+    """
+    w = np.asarray(w, dtype=np.float64)
+    t2 = np.einsum("mi,mi->m", w, w)
+    t = np.sqrt(t2)
+    small = t < tol.SO3_SMALL_ANGLE
+    ts = np.where(small, 1.0, t)
+    a = np.where(small, 0.5 - t2 / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
+    b = np.where(small, 1.0 / 6.0 - t2 / 120.0, (ts - np.sin(ts)) / ts ** 3)
+    W = np.zeros((len(w), 3, 3))
+    W[:, 0, 1], W[:, 0, 2], W[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    W[:, 1, 0], W[:, 2, 0], W[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
+    return np.eye(3) - a[:, None, None] * W + b[:, None, None] * (W @ W)

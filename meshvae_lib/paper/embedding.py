@@ -50,7 +50,7 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
         for sd in seeds:
             m = train_model(coll, s, cache, sigma_object=so, holdout=False, prior=prior, alpha=a, hidden=h, seed=sd,
                             epochs=ep)
-            y = m.encode_meshes(coll.vertices)[:, :2]
+            y = m.encode_meshes(coll.vertices, inference="encoder")[:, :2]
             out[sd] = (y, ret.precision_recall_curve(y, labels, relevance=relevance))
         order = sorted(seeds, key=lambda sd: out[sd][1].auc["mean"])
         return out, order[(len(order) - 1) // 2], m

@@ -47,7 +47,7 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
         table.rows.append([r["dim"], r["controls"], r["correlation"], r["effect (std)"]]
                           + [r[f"corr {n}"] for n in effects.names])
     # also: correlation of the encoder means with the measurements over the data set
-    mu = model.encode_meshes(coll.vertices)
+    mu = model.encode_meshes(coll.vertices, inference="encoder")   # the paper: encoder means
     C, names = ex.latent_measurement_correlation(mu[:, list(dims)], measure(coll.vertices))
     table.data.update(effects=effects, level1=level1, level2=level2, faces=coll.faces, data_correlation=C,
                       data_correlation_names=names)

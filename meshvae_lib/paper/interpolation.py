@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from meshvae_lib.paper.protocol import load_collection, name_of, timed, train_model
@@ -37,7 +39,8 @@ def interpolation_table(collection: str = "jumping", pair=None, n_steps: int = 9
     else:
         a, b = (int(i) for i in pair)
     seqs = {}
-    z, seqs["latent (ours)"] = itp.interpolate_latent(model.encode_meshes, model.decode_latent,
+    encode = functools.partial(model.encode_meshes, inference="encoder")      # the paper: encoder means
+    z, seqs["latent (ours)"] = itp.interpolate_latent(encode, model.decode_latent,
                                                        coll.vertices[a], coll.vertices[b], n_steps)
     if ext.kind == "rimd":
         seqs["linear RIMD"] = itp.interpolate_features(R[a], R[b], n_steps, ext.inverse_transform)

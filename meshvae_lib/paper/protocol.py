@@ -152,11 +152,15 @@ def train_model(coll: CollectionData, settings: ExperimentSettings, cache: dict 
     return model
 
 
-def heldout_error(model, coll: CollectionData) -> dict:
-    """:func:`~meshvae_lib.model.evaluation.evaluate_model` on the held-out meshes."""
+def heldout_error(model, coll: CollectionData, inference: str = "encoder") -> dict:
+    """:func:`~meshvae_lib.model.evaluation.evaluate_model` on the held-out meshes.
+
+    inference : "encoder" (default here: the paper's protocol encodes with the network) or the
+        library's default "gauss-newton" (codes refined on the vertex error, issue 23).
+    """
     from meshvae_lib.model.evaluation import evaluate_model
 
-    return evaluate_model(model, coll, held_out_only=True)
+    return evaluate_model(model, coll, held_out_only=True, inference=inference)
 
 
 def safe_reference(index: int, n: int, every: int) -> int:
