@@ -5,10 +5,11 @@ collection: raw 3D coordinates, coordinates after rigidly aligning every mesh to
 RIMD features. Every ``--holdout-every``-th mesh is held out (``training.holdout_mask``); the table
 gives, per feature kind, the mean per-vertex error of the training and of the held-out meshes
 (encoded to the latent mean, decoded, aligned rigidly to the truth, as ``meshvae evaluate``
-measures it), in the mesh's units, the training time (features + training) and the epochs early
-stopping chose; with ``--fit-latent N`` also the held-out error when each held-out mesh's latent
-code is fitted to its vertices through the decoder (``MeshVAEModel.fit_latent``, an option beside
-the paper's encoder). Two linear rows close each table: PCA on coordinates and on aligned coordinates,
+measures it), in the mesh's units, the training time (features + training), the epochs early
+stopping chose and the encoding time per held-out mesh. Every model is evaluated with each
+inference strategy of ``--inference`` (default: the library's default, Gauss-Newton from the
+encoder's means with the analytic Jacobian, and the paper's feed-forward encoder); with
+``--fit-latent N`` also with codes fitted by finite differences (``MeshVAEModel.fit_latent``). Two linear rows close each table: PCA on coordinates and on aligned coordinates,
 fitted on the training meshes with every direction they span (``evaluation.pca_baseline``).
 
 Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
@@ -69,33 +70,42 @@ def run_collection(coll, name: str, args) -> list[dict]:
     print(f"\n{name}: {len(V)} meshes ({int((~mask).sum())} train / {int(mask.sum())} held out), {V.shape[1]} vertices,"
           f" mean bounding-box diagonal {diag:.4g}; {'the paper' if args.legacy else 'library default (PCA start)'} training,"
           f" {torch.get_num_threads()} thread(s)", flush=True)
-    print(f"{'features':18s} {'K':>7s} {'train error':>12s} {'held-out':>10s} {'% diag':>7s} {'epochs':>6s} {'time (s)':>9s}",
-          flush=True)
+    print(f"{'features (inference)':26s} {'K':>7s} {'train error':>12s} {'held-out':>10s} {'% diag':>7s} {'epochs':>6s}"
+          f" {'train (s)':>9s} {'s / mesh':>9s}", flush=True)
     rows = []
     for kind in args.kinds.split(","):
         t0 = time.perf_counter()
         model = MeshVAEModel(kind, config_for(kind, args.legacy, args.seed, args.epochs),
                              holdout_every=args.holdout_every).fit(coll)
         seconds = time.perf_counter() - t0
-        held = evaluate_model(model, coll, held_out_only=True)
-        train = evaluate_model(model, coll, indices=np.flatnonzero(~model.holdout_mask_))
-        row = {"collection": name, "features": kind, "K": int(model.network_.n_features),
-               "train_error": train["mean_vertex_error"], "held_out_error": held["mean_vertex_error"],
-               "relative_error": held["relative_error"], "epochs": int(model.train_epochs_), "seconds": seconds}
-        rows.append(row)
-        print(f"{kind:18s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
-              f" {100 * row['relative_error']:7.3f} {row['epochs']:6d} {seconds:9.1f}", flush=True)
+        if args.save_models:
+            Path(args.save_models).mkdir(parents=True, exist_ok=True)
+            model.save(Path(args.save_models) / f"{name.replace('/', '_')}_{kind}.pt")
+        train = evaluate_model(model, coll, indices=np.flatnonzero(~model.holdout_mask_), inference="encoder")
+        for inference in args.inference.split(","):
+            held = evaluate_model(model, coll, held_out_only=True, inference=inference)
+            label = kind if inference == "gauss-newton" else f"{kind} ({inference})"
+            row = {"collection": name, "features": label, "kind": kind, "inference": inference,
+                   "K": int(model.network_.n_features), "train_error": train["mean_vertex_error"],
+                   "held_out_error": held["mean_vertex_error"], "relative_error": held["relative_error"],
+                   "epochs": int(model.train_epochs_), "seconds": seconds,
+                   "encode_seconds_per_mesh": held["seconds_per_mesh"],
+                   "per_mesh": held["per_mesh"]}
+            rows.append(row)
+            print(f"{label:26s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
+                  f" {100 * row['relative_error']:7.3f} {row['epochs']:6d} {seconds:9.1f}"
+                  f" {held['seconds_per_mesh']:9.3f}", flush=True)
         if args.fit_latent:
-            t0 = time.perf_counter()
             fitted = evaluate_model(model, coll, held_out_only=True, fit_iterations=args.fit_latent)
-            fit_s = time.perf_counter() - t0
             label = f"{kind} fit z ({args.fit_latent})"
-            rows.append({"collection": name, "features": label, "K": row["K"], "train_error": float("nan"),
+            rows.append({"collection": name, "features": label, "kind": kind, "inference": "finite-difference",
+                         "K": row["K"], "train_error": float("nan"),
                          "held_out_error": fitted["mean_vertex_error"], "relative_error": fitted["relative_error"],
-                         "epochs": row["epochs"], "seconds": fit_s})
-            print(f"{label:18s} {row['K']:7d} {'':>12s} {fitted['mean_vertex_error']:10.4e}"
-                  f" {100 * fitted['relative_error']:7.3f} {'':>6s} {fit_s:9.1f}   (codes fitted to the held-out vertices)",
-                  flush=True)
+                         "epochs": row["epochs"], "seconds": seconds,
+                         "encode_seconds_per_mesh": fitted["seconds_per_mesh"]})
+            print(f"{label:26s} {row['K']:7d} {'':>12s} {fitted['mean_vertex_error']:10.4e}"
+                  f" {100 * fitted['relative_error']:7.3f} {'':>6s} {seconds:9.1f} {fitted['seconds_per_mesh']:9.3f}"
+                  "   (codes fitted by finite differences)", flush=True)
     latent = TrainConfig().latent_dim
     pcas = [(False, None), (True, None)]
     if int((~mask).sum()) - 1 > latent:  # the VAE has only D latent dimensions: PCA with as many too
@@ -108,7 +118,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
                "held_out_error": res["mean_vertex_error"], "relative_error": res["relative_error"],
                "epochs": 0, "seconds": time.perf_counter() - t0, "n_components": res["n_components"]}
         rows.append(row)
-        print(f"{label:18s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
+        print(f"{label:26s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
               f" {100 * row['relative_error']:7.3f} {'':>6s} {row['seconds']:9.1f}   ({res['n_components']} components)",
               flush=True)
     err = {r["features"]: r["held_out_error"] for r in rows}
@@ -133,11 +143,16 @@ def main() -> None:
     ap.add_argument("--kinds", default=",".join(KINDS))
     ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
     ap.add_argument("--legacy", action="store_true", help="the paper's training instead of the library's default (the PCA start)")
+    ap.add_argument("--inference", default="gauss-newton,encoder",
+                    help="comma-separated inference strategies to evaluate every model with (MeshVAEModel.encode_meshes;"
+                         " default: the library's default, gauss-newton, and the paper's encoder)")
     ap.add_argument("--fit-latent", type=int, default=0, metavar="N",
-                    help="also evaluate with latent codes fitted to the held-out vertices (N Gauss-Newton steps)")
+                    help="also evaluate with latent codes fitted by finite differences (N Gauss-Newton steps)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--json", default=None, metavar="OUT.json", help="also write the rows as JSON")
+    ap.add_argument("--save-models", default=None, metavar="DIR",
+                    help="also save every trained model to DIR/<collection>_<kind>.pt (for bench_inference.py)")
     args = ap.parse_args()
     os.environ.setdefault("OMP_NUM_THREADS", str(args.threads))
     torch.set_num_threads(args.threads)

@@ -1,0 +1,67 @@
+"""Speed of the latent inference strategies: seconds to encode one mesh (issue 23).
+
+Loads a trained model (``--model m.pt`` with its collection ``--real NAME`` of ../shared/data, or
+trains a default RIMD model on a data_synth collection) and times ``encode_meshes`` of single
+held-out meshes with each strategy: the paper's encoder, the default Gauss-Newton (analytic
+Jacobian) and, with ``--finite-difference``, the old forward-difference fit. Medians over
+``--repeats`` runs of each of ``--meshes`` meshes (the machines are shared and noisy).
+
+    python benchmarks/feature_comparison.py --real samba --kinds rimd --save-models /tmp/models
+    python benchmarks/bench_inference.py --model /tmp/models/samba_rimd.pt --real samba
+    python benchmarks/bench_inference.py --synth scape            # without the real data
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+import torch
+
+from feature_comparison import load_real
+from meshvae_lib.model.checkpoint import load_model
+from meshvae_lib.model.meshvae_model import MeshVAEModel
+from meshvae_lib.model.train_config import TrainConfig
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--model", default=None, help="a trained checkpoint (with --real)")
+    ap.add_argument("--real", default=None, help="its collection in ../shared/data")
+    ap.add_argument("--subsample", type=int, default=1)
+    ap.add_argument("--synth", default="scape", help="data_synth collection when no model is given")
+    ap.add_argument("--meshes", type=int, default=3)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--finite-difference", action="store_true", help="also time the forward-difference fit (slow)")
+    args = ap.parse_args()
+    torch.set_num_threads(args.threads)
+    if args.model:
+        coll = load_real(args.real, args.subsample)
+        model = load_model(args.model, coll)
+    else:
+        from data_synth.registry import make_collection
+
+        coll = make_collection(args.synth, seed=0)
+        model = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=5).fit(coll)
+    V = np.asarray(coll.vertices, dtype=np.float64)[model.holdout_mask_][: args.meshes]
+    model.encode_meshes(V[:1])                       # build the reconstructor's factorisations once
+    methods = ["encoder", "gauss-newton"] + (["finite-difference"] if args.finite_difference else [])
+    print(f"{V.shape[1]} vertices, K = {model.network_.n_features}, latent {model.network_.latent_dim},"
+          f" {torch.get_num_threads()} thread(s); seconds per mesh, median of {args.repeats} x {len(V)}")
+    for method in methods:
+        times = []
+        for _ in range(args.repeats):
+            for x in V:
+                t0 = time.perf_counter()
+                model.encode_meshes(x[None], inference=method, iterations=4 if method == "gauss-newton" else 3)
+                times.append(time.perf_counter() - t0)
+        extra = f", {model.last_inference_!r}" if method == "gauss-newton" else ""
+        print(f"{method:18s} {statistics.median(times):8.3f} s  (min {min(times):.3f}, max {max(times):.3f}){extra}",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
