@@ -52,6 +52,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         " not held out (no value), or all meshes of the collection TRAIN")
     p.add_argument("--pca-components", type=int, default=None, metavar="K",
                    help="principal components of the PCA baseline (default: all the training meshes span)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar while codes are fitted")
     add_allow_degenerate(p)
     return p
 
@@ -67,7 +68,7 @@ def run(args) -> int:
     if args.fit_latent and args.inference not in (None, "finite-difference"):
         raise UsageError(f"--fit-latent fits by finite differences; it does not combine with --inference {args.inference}")
     res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent,
-                         inference=args.inference)
+                         inference=args.inference, progress=not args.no_progress)
     if args.pca is not None:
         import numpy as np
 

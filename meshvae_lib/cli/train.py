@@ -117,7 +117,7 @@ def run(args) -> int:
     result(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
            f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.network_.n_features}")
     if model.holdout_mask_.any():
-        res = evaluate_model(model, collection, held_out_only=True)
+        res = evaluate_model(model, collection, held_out_only=True, progress=not args.no_progress)
         result(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"
                f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal)")
     result(f"wrote {args.output}")

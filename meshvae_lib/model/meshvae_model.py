@@ -249,12 +249,13 @@ class MeshVAEModel:
         return V[0] if single else V
 
     def reconstruct(self, vertices, conditions=None, labels=None, fit_iterations: int = 0,
-                    inference: str | None = None) -> np.ndarray:
+                    inference: str | None = None, progress: bool = False) -> np.ndarray:
         """Encode (:meth:`encode_meshes`, the model's inference unless ``inference`` says) and
         decode: meshes (N, n, 3) -> (N, n, 3) float64.
 
         ``fit_iterations > 0``: the finite-difference fit with that many steps (:meth:`fit_latent`;
         the same as ``inference="finite-difference"``, kept for ``meshvae evaluate --fit-latent``).
+        ``progress``: a progress bar while codes are fitted.
         """
         if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
             labels = vertices.labels
@@ -262,7 +263,7 @@ class MeshVAEModel:
             z = self.encode_meshes(vertices, conditions, labels, inference="finite-difference",
                                    iterations=fit_iterations)
         else:
-            z = self.encode_meshes(vertices, conditions, labels, inference=inference)
+            z = self.encode_meshes(vertices, conditions, labels, inference=inference, progress=progress)
         return self.decode_latent(z, conditions, labels)
 
     def fit_latent(self, vertices, iterations: int = 3, z0=None, conditions=None, labels=None,
