@@ -236,3 +236,24 @@ def test_inference_options_are_checked(arcs, arc_model):
         arc_model.encode_meshes(arcs.vertices[:2], iterations=0)
     mu, sigma = arc_model.encode_meshes(arcs.vertices[:2], inference="encoder", return_sigma=True)
     assert mu.shape == sigma.shape == (2, 8) and np.all(sigma > 0)
+
+
+def test_a_code_where_the_decoder_saturates_ends_the_fit_instead_of_failing(arcs, arc_model, tmp_path):
+    """Far outside the training meshes every tanh output can saturate: the decoded mesh then no
+    longer moves with the code (J = 0; found on notebook 10's bar with 8 training meshes). The fit
+    stops at the best code found so far instead of failing on a singular system."""
+    from meshvae_lib.model.checkpoint import load_model
+
+    saturated = load_model(arc_model.save(tmp_path / "arcs.pt"), arcs)
+    with torch.no_grad():
+        saturated.network_.decoder_head.bias.fill_(50.0)     # tanh(50 + W z) == 1.0 in float64
+    V = arcs.vertices[:2]
+    z0 = saturated.encode_meshes(V, inference="encoder")
+    z, report = gauss_newton_codes(saturated, V, z0, iterations=3)
+    np.testing.assert_array_equal(z, z0)
+    assert np.all(report.decodes == 1) and np.all(report.iterations == 1)
+    # a decoder that ignores the code altogether: nothing to fit
+    with torch.no_grad():
+        saturated.network_.decoder_head.weight.zero_()
+    z, report = gauss_newton_codes(saturated, V, z0, iterations=3)
+    np.testing.assert_array_equal(z, z0)

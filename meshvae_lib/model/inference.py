@@ -191,6 +191,8 @@ class _DecodedState:
         self.residual = rigid_align(x, P) - P                      # (n, 3): target moved onto P
         self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
         self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
+        if not np.isfinite(self.sq_error):
+            self.sq_error = self.mean_error = np.inf              # never accepted
 
 
 def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: np.ndarray | None = None,
@@ -225,6 +227,8 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     report = GaussNewtonReport(len(V))
     decoder = _Decoder(model, conditions)
     used = decoder.used
+    if not len(used):                                  # the decoder ignores the code: nothing to fit
+        iterations = 0
     meshes = progress_bar(range(len(V)), desc="fitting codes", unit="mesh", disable=not progress)
     for j in meshes:
         c = None if conditions is None else conditions[j]
@@ -240,6 +244,8 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
             H = J.T @ J
             g = J.T @ state.residual.ravel()
             mean_diag = float(np.trace(H)) / len(used)
+            if not (mean_diag > 0 and np.isfinite(H).all() and np.isfinite(g).all()):
+                break     # the decoded mesh does not move with the code here (a saturated output)
             accepted = None
             for _ in range(tol.GN_MAX_TRIES):
                 z_new = Z[j].copy()
