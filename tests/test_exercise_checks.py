@@ -1,10 +1,11 @@
-"""Every exercise's self-check fails on a trivial answer.
+"""Every exercise's self-check fails on a trivial answer, and on the wrong answers known to fool it.
 
 For each notebook, :func:`~meshvae_lib.course.notebooks.trivial_answer_notebook` gives the names
 each solution binds three trivial answers in turn -- left unchanged (undefined, or the value they
-had before the exercise), ``None``, and zeros of the real answer's type and shape -- runs the
-self-check on each, then restores the real answer. The notebook is executed once (the course
-models come from the cache, as for nbval), and every self-check must raise on every trivial answer.
+had before the exercise), ``None``, and zeros of the real answer's type and shape --, then runs
+each named wrong answer of :data:`WRONG_ANSWERS` in place of the solution; it runs the self-check
+on each, then restores the real answer. The notebook is executed once (the course models come
+from the cache, as for nbval), and every self-check must raise on every one of them.
 """
 
 from __future__ import annotations
@@ -19,6 +20,76 @@ from meshvae_lib.course.notebooks import (TRIVIAL_ANSWERS, solution_names, trivi
 
 NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
+
+#: (notebook stem, exercise number from 1) -> {name: code run in place of the solution}: one-line
+#: wrong answers that self-checks accepted, each of which its self-check must now reject.
+WRONG_ANSWERS = {
+    ("01_deformation_gradients", 1): {
+        "the mesh is never rotated": (
+            "Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n"
+            "T_before = op(V1)\n"
+            "T_after = Q @ T_before\n"
+            "rigid_err = 0.0\n"),
+        "the mesh is moved but not measured": (
+            "Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n"
+            "V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n"
+            "T_before = op(V1)\n"
+            "T_after = Q @ T_before\n"
+            "rigid_err = 0.0\n"),
+    },
+    ("01_deformation_gradients", 2): {
+        "library weights typed in from the printout": (
+            "c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n"
+            "P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n"
+            "P_sq = np.array([[0.0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 0, 0]])\n"
+            "pair = np.array([[0, 1, 2], [1, 0, 3]])\n"
+            "lib_eq, lib_sq = 1.1547, 0.0\n"),
+        "the square is never built": (
+            "c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n"
+            "P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n"
+            "P_sq = P_eq.copy()\n"
+            "pair = np.array([[0, 1, 2], [1, 0, 3]])\n"
+            "lib_eq = float(cotangent_weights(P_eq, pair, clamp=False)[edge_index(edges(pair), 0, 1)])\n"
+            "lib_sq = 0.0\n"),
+    },
+    ("02_rimd", 2): {
+        "V_lin is the feature midpoint": (
+            "Va, Vb = col.vertices[poses[0]], col.vertices[poses[2]]\n"
+            "fa, fb = enc.transform(Va), enc.transform(Vb)\n"
+            "V_mid = rec['exact'].reconstruct(0.5 * (fa + fb))\n"
+            "V_lin = V_mid.copy()\n"
+            "len_mid = len_lin = np.linalg.norm(V_mid[E[:, 0]] - V_mid[E[:, 1]], axis=1).mean()\n"
+            "len_ref = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1).mean()\n"),
+    },
+    ("03_normalization", 2): {
+        "margin typed in from the text": (
+            "f_top = norm.inverse_transform(np.ones((1, X.shape[1])))[0]\n"
+            "margin = 1 / 18\n"),
+        "f_top is the training maximum": (
+            "f_top = X.max(axis=0)\n"
+            "margin = np.full(X.shape[1], 1 / 18)\n"),
+    },
+    ("07_sigma_object_embeddings", 1): {
+        "the check's own expression": "gap = exact - sibling\n",
+        "the total split evenly": "gap = torch.full((3,), (exact - sibling) / 3)\n",
+    },
+    ("07_sigma_object_embeddings", 2): {
+        "only pair (1, 2) right": (
+            "pair_auc = np.r_[curves['σ_object VAE (ours)'].auc['mean'], np.full(LATENT // 2 - 1, 0.5)]\n"),
+        "overlapping pairs (1, 2), (2, 3), ...": (
+            "pair_auc = np.array([ret.retrieval_auc(Z[median_seed][:, i:i + 2], labels) for i in range(LATENT // 2)])\n"),
+    },
+    ("08_exploration", 1): {
+        "strength [1, 1, 1, 1, 0, ...]": "strength = np.r_[np.ones(4), np.zeros(LATENT - 4)]\n",
+        "only the four dimensions of section 4 swept": (
+            "strength = np.r_[np.abs(effects.effect).max(axis=1), np.zeros(LATENT - 4)]\n"),
+    },
+}
+
+
+def wrong_answers_of(stem: str) -> dict[int, dict[str, str]]:
+    """The named wrong answers of one notebook, by exercise number."""
+    return {exercise: answers for (nb_stem, exercise), answers in WRONG_ANSWERS.items() if nb_stem == stem}
 
 
 def test_solution_names_are_the_global_bindings():
@@ -55,15 +126,71 @@ def test_the_trivial_answer_notebook_wraps_each_exercise():
     assert ns["answer"] == 10, "the real answer is restored for the rest of the notebook"
 
 
+def _run_cells(nb) -> tuple[dict, list[str]]:
+    import contextlib
+    import io
+
+    ns, printed = {}, []
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            buf = io.StringIO()
+            with contextlib.redirect_stdout(buf):
+                exec(cell.source, ns)
+            printed.append(buf.getvalue())
+    return ns, printed
+
+
+def test_the_trivial_answer_notebook_tries_named_wrong_answers():
+    nb = nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell("start = 5"),
+        nbformat.v4.new_code_cell("### BEGIN SOLUTION\nanswer = start * 2\n### END SOLUTION"),
+        nbformat.v4.new_code_cell("assert answer == 2 * start"),
+        nbformat.v4.new_code_cell("### BEGIN SOLUTION\nsquare = answer ** 2\n### END SOLUTION"),
+        nbformat.v4.new_code_cell("assert square > 0"),
+    ])
+    wrong = {1: {"typed in": "answer = 10\nscratch = 1", "tripled": "answer = start * 3", "broken": "answer = nope"},
+             2: {"negative": "square = -answer"}}
+    out, exercises = trivial_answer_notebook(nb, wrong_answers=wrong)
+    assert exercises == [(1, ["answer"]), (3, ["square"])]
+    ns, printed = _run_cells(out)
+    outcomes = trivial_answer_outcomes(nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell(outputs=[nbformat.v4.new_output("stream", name="stdout", text=text)]) for text in printed]))
+    assert outcomes[0] == {"unchanged": "NameError", "None": "AssertionError", "zeros": "AssertionError",
+                           "typed in": "passed", "tripled": "AssertionError",
+                           "broken": "the wrong answer itself raised NameError"}
+    assert outcomes[1] == {"unchanged": "NameError", "None": "TypeError", "zeros": "AssertionError",
+                           "negative": "AssertionError"}
+    assert ns["answer"] == 10 and ns["square"] == 100, "the real answers are restored"
+    assert "scratch" not in ns, "names a wrong answer adds are removed"
+    with pytest.raises(ValueError, match="exercises \\[3\\]"):
+        trivial_answer_notebook(nb, wrong_answers={3: {"x": "pass"}})
+    with pytest.raises(ValueError, match="trivial answers' names"):
+        trivial_answer_notebook(nb, wrong_answers={1: {"None": "answer = None"}})
+
+
+def test_every_wrong_answer_names_an_existing_exercise():
+    for (stem, exercise), answers in WRONG_ANSWERS.items():
+        path = NOTEBOOK_DIR / f"{stem}.ipynb"
+        assert path.exists(), stem
+        assert answers and not set(answers) & set(TRIVIAL_ANSWERS), (stem, exercise)
+        trivial_answer_notebook(nbformat.read(path, as_version=4), wrong_answers={exercise: answers})
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
-def test_every_self_check_raises_on_trivial_answers(path):
+def test_every_self_check_raises_on_trivial_and_known_wrong_answers(path):
     from nbclient import NotebookClient
 
-    nb, exercises = trivial_answer_notebook(nbformat.read(path, as_version=4))
+    wrong = wrong_answers_of(path.stem)
+    nb, exercises = trivial_answer_notebook(nbformat.read(path, as_version=4), wrong_answers=wrong)
     assert len(exercises) >= 2, f"{path.stem} has {len(exercises)} exercise(s)"
     NotebookClient(nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(NOTEBOOK_DIR)}}).execute()
     outcomes = trivial_answer_outcomes(nb)
     assert len(outcomes) == len(exercises)
-    passed = [(cell, names, answer) for (cell, names), o in zip(exercises, outcomes)
-              for answer in TRIVIAL_ANSWERS if o[answer] == "passed"]
-    assert not passed, f"{path.stem}: self-checks that accept a trivial answer (cell, answer names, answer): {passed}"
+    accepted = []   # (exercise, solution cell, answer names, answer, outcome)
+    for number, ((cell, names), o) in enumerate(zip(exercises, outcomes), start=1):
+        for answer in (*TRIVIAL_ANSWERS, *wrong.get(number, {})):
+            print(f"{path.stem} exercise {number} (cell {cell}), {answer!r}: {o[answer]}")
+            if o[answer] == "passed" or o[answer].startswith("the wrong answer itself"):
+                accepted.append((number, cell, names, answer, o[answer]))
+    assert not accepted, (f"{path.stem}: self-checks that accept a trivial or wrong answer, or wrong answers that do "
+                          f"not run (exercise, cell, answer names, answer, outcome): {accepted}")

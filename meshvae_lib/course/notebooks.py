@@ -245,7 +245,7 @@ def solution_names(source: str) -> list[str]:
 
 _TRIVIAL_CELL = '''\
 import json as _tj, numpy as _tnp
-_t_names, _t_check = {names!r}, {check!r}
+_t_names, _t_check, _t_wrong = {names!r}, {check!r}, {wrong!r}
 _t_real = {{n: globals()[n] for n in _t_names if n in globals()}}
 def _t_zero(v):
     if isinstance(v, bool):
@@ -260,20 +260,31 @@ def _t_zero(v):
         return type(v)()
     return None
 _t_outcomes = {{}}
-for _t_answer in {answers!r}:
+for _t_answer in {answers!r} + tuple(_t_wrong):
     for _t_n in _t_names:
         globals().pop(_t_n, None)
-        if _t_answer == "unchanged" and _t_n in _t_before:
+        if _t_answer in ("unchanged", *_t_wrong) and _t_n in _t_before:
             globals()[_t_n] = _t_before[_t_n]
         elif _t_answer == "None":
             globals()[_t_n] = None
         elif _t_answer == "zeros":
             globals()[_t_n] = _t_zero(_t_real.get(_t_n))
+    _t_known = set(globals())
     try:
+        if _t_answer in _t_wrong:
+            try:
+                exec(_t_wrong[_t_answer], globals())
+            except BaseException as _t_e:
+                _t_outcomes[_t_answer] = "the wrong answer itself raised " + type(_t_e).__name__
+                continue
         exec(_t_check, globals())
         _t_outcomes[_t_answer] = "passed"
     except BaseException as _t_e:
         _t_outcomes[_t_answer] = type(_t_e).__name__
+    finally:
+        for _t_n in set(globals()) - _t_known:
+            if not _t_n.startswith("_t_"):
+                globals().pop(_t_n, None)
 for _t_n in _t_names:
     globals().pop(_t_n, None)
 globals().update(_t_real)
@@ -281,8 +292,8 @@ print({marker!r}, _tj.dumps(_t_outcomes))
 '''
 
 
-def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS):
-    """A copy of ``nb`` that tries trivial answers on every exercise's self-check.
+def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS, wrong_answers=None):
+    """A copy of ``nb`` that tries trivial answers, and known wrong ones, on every exercise's self-check.
 
     For each solution cell (``### BEGIN SOLUTION``) followed by its self-check (the next code
     cell), a cell before the solution remembers the answer names' starting values, and a cell
@@ -292,17 +303,33 @@ def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS):
     an empty container; None for other objects) --, (b) runs the self-check's source on it and
     records whether it raised, then (c) restores the real answers, so that the rest of the
     notebook runs as usual. This is what a student copy (:func:`student_notebook`) with that
-    answer in place of the solution would do. Executing the result prints one line per
-    exercise, ``TRIVIAL-ANSWER-OUTCOMES {"unchanged": "AssertionError", ...}``
+    answer in place of the solution would do.
+
+    ``wrong_answers`` adds named wrong answers per exercise: ``{exercise number (1-based, in
+    notebook order): {name: code}}``. Each code runs in place of the solution, on the state
+    before it (the solution's names back at their starting values, undefined if they had none);
+    then the self-check runs as above. Names the wrong answer or the check bind that did not
+    exist before are removed afterwards. A wrong answer whose own code raises is recorded as
+    ``"the wrong answer itself raised <exception>"``, not as caught.
+
+    Executing the result prints one line per exercise, ``TRIVIAL-ANSWER-OUTCOMES {"unchanged":
+    "AssertionError", ..., "<wrong answer name>": "AssertionError"}``
     (:func:`trivial_answer_outcomes` reads them).
 
     Returns (notebook, exercises): ``exercises`` lists, per exercise, ``(solution cell index in
     nb, names)``.
+
+    Raises
+    ------
+    ValueError
+        When a solution has no self-check after it, or ``wrong_answers`` names an exercise the
+        notebook does not have or reuses a trivial answer's name.
     """
     import copy
 
     import nbformat
 
+    wrong_answers = dict(wrong_answers or {})
     src = copy.deepcopy(nb)
     cells, exercises = [], []
     code_after = {}
@@ -318,11 +345,18 @@ def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS):
             raise ValueError(f"the solution in cell {i} has no self-check cell after it")
         names = solution_names(cell.source)
         exercises.append((i, names))
+        wrong = dict(wrong_answers.get(len(exercises), {}))
+        clash = set(wrong) & set(answers)
+        if clash:
+            raise ValueError(f"wrong answers of exercise {len(exercises)} reuse the trivial answers' names {sorted(clash)}")
         cells.append(nbformat.v4.new_code_cell(f"_t_before = {{n: globals()[n] for n in {names!r} if n in globals()}}"))
         cells.append(cell)
         check = src.cells[code_after[i]].source
         cells.append(nbformat.v4.new_code_cell(_TRIVIAL_CELL.format(names=names, check=check, answers=tuple(answers),
-                                                                  marker=TRIVIAL_MARKER)))
+                                                                  wrong=wrong, marker=TRIVIAL_MARKER)))
+    unknown = sorted(set(wrong_answers) - set(range(1, len(exercises) + 1)))
+    if unknown:
+        raise ValueError(f"wrong answers for exercises {unknown}, but the notebook has {len(exercises)} exercise(s)")
     src.cells = cells
     return src, exercises
 
