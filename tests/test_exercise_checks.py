@@ -69,6 +69,12 @@ WRONG_ANSWERS = {
             "f_top = X.max(axis=0)\n"
             "margin = np.full(X.shape[1], 1 / 18)\n"),
     },
+    ("04_training", 1): {
+        "zero tensors with sigma = 1": (
+            "x = x_hat = mu = torch.zeros(8, 4)\n"
+            "sigma = torch.ones(8, 4)\n"
+            "rec_term = kl_term = 0.0\n"),
+    },
     ("07_sigma_object_embeddings", 1): {
         "the check's own expression": "gap = exact - sibling\n",
         "the total split evenly": "gap = torch.full((3,), (exact - sibling) / 3)\n",
@@ -83,6 +89,20 @@ WRONG_ANSWERS = {
         "strength [1, 1, 1, 1, 0, ...]": "strength = np.r_[np.ones(4), np.zeros(LATENT - 4)]\n",
         "only the four dimensions of section 4 swept": (
             "strength = np.r_[np.abs(effects.effect).max(axis=1), np.zeros(LATENT - 4)]\n"),
+    },
+    ("10_bring_your_own", 1): {
+        "any three meshes of the data": (
+            "column = next(iter(coll.labels))\n"
+            "value = sorted(set(coll.labels[column]))[0]\n"
+            "cond = MeshVAEModel('rimd', config, labels=(column,), layout='compact').fit(coll)\n"
+            "cond_meshes = coll.vertices[:3]\n"),
+    },
+    ("10_bring_your_own", 2): {
+        "err_shuffled = 1.0": (
+            "rng = np.random.default_rng(SEED)\n"
+            "Vs = coll.vertices[1][rng.permutation(coll.n_vertices)]\n"
+            "shuffled = collection.MeshCollection(Vs[None], coll.faces, ['shuffled'], {})\n"
+            "err_shuffled = 1.0\n"),
     },
 }
 

@@ -370,8 +370,10 @@ def trivial_answer_outcomes(executed_nb) -> list[dict]:
     for cell in executed_nb.cells:
         if cell.cell_type != "code":
             continue
-        for out in cell.get("outputs", []):
-            for line in out.get("text", "").splitlines():
-                if line.startswith(TRIVIAL_MARKER):
-                    found.append(json.loads(line[len(TRIVIAL_MARKER):]))
+        # a kernel may split one printed line over several stream messages: join a cell's stdout first
+        stdout = "".join(out.get("text", "") for out in cell.get("outputs", [])
+                         if out.get("output_type") == "stream" and out.get("name", "stdout") == "stdout")
+        for line in stdout.splitlines():
+            if line.startswith(TRIVIAL_MARKER):
+                found.append(json.loads(line[len(TRIVIAL_MARKER):]))
     return found
