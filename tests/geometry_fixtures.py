@@ -76,6 +76,16 @@ def grid(nx: int = 4, ny: int = 3, size: float = 1.0) -> tuple[np.ndarray, np.nd
     return V, F.astype(np.int64)
 
 
+def strip(nx: int = 13, ny: int = 4, length: float = 3.0, width: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    """Flat strip ``length x width`` in the z = 0 plane, ``nx * ny`` vertices ordered along x first
+    (``indexing="ij"``), each quad split along the same diagonal."""
+    x, y = np.meshgrid(np.linspace(0, length, nx), np.linspace(0, width, ny), indexing="ij")
+    P = np.stack([x.ravel(), y.ravel(), np.zeros(nx * ny)], 1)
+    a = (np.arange(nx - 1)[:, None] * ny + np.arange(ny - 1)[None, :]).ravel()
+    F = np.stack([np.stack([a, a + ny, a + 1], 1), np.stack([a + ny, a + ny + 1, a + 1], 1)], 1).reshape(-1, 3)
+    return P, F.astype(np.int64)
+
+
 def bumpy(V: np.ndarray, amount: float = 0.05, seed: int = 0) -> np.ndarray:
     """Reference mesh with small random bumps (so no one-ring is exactly symmetric)."""
     rng = np.random.default_rng(seed)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import torch
 
+from geometry_fixtures import strip
 from meshvae_lib.cli import main
 from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.geometry.collection_io import read_collection, write_collection
@@ -16,13 +17,7 @@ torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-co
 
 def _strips(n=16, nx=8, ny=3, seed=0):
     rng = np.random.default_rng(seed)
-    x, y = np.meshgrid(np.linspace(0, 2, nx), np.linspace(0, 0.5, ny), indexing="ij")
-    P = np.stack([x.ravel(), y.ravel(), np.zeros(nx * ny)], 1)
-    F = []
-    for i in range(nx - 1):
-        for j in range(ny - 1):
-            a = i * ny + j
-            F += [[a, a + ny, a + 1], [a + ny, a + ny + 1, a + 1]]
+    P, F = strip(nx, ny, length=2.0, width=0.5)
     Vs = []
     for k in range(n):
         V = P.copy()

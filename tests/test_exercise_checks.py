@@ -131,17 +131,8 @@ def test_the_trivial_answer_notebook_wraps_each_exercise():
     assert exercises == [(1, ["answer"])]
     assert [c.cell_type for c in out.cells] == ["code", "code", "code", "code", "markdown", "code"]
     assert "assert answer == 10" in out.cells[3].source and "TRIVIAL-ANSWER-OUTCOMES" in out.cells[3].source
-    ns = {}
-    for cell in out.cells:
-        if cell.cell_type == "code":
-            import contextlib
-            import io
-
-            buf = io.StringIO()
-            with contextlib.redirect_stdout(buf):
-                exec(cell.source, ns)
-            if "TRIVIAL" in buf.getvalue():
-                line = buf.getvalue()
+    ns, printed = _run_cells(out)
+    line = [p for p in printed if "TRIVIAL" in p][-1]
     assert '"unchanged": "NameError"' in line and '"None": "AssertionError"' in line and '"zeros": "AssertionError"' in line
     assert ns["answer"] == 10, "the real answer is restored for the rest of the notebook"
 

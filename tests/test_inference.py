@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import torch
 
+from geometry_fixtures import strip
 from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 from meshvae_lib.geometry.rimd import RIMDEncoder
@@ -17,21 +18,10 @@ from meshvae_lib.model.vae import MeshVAE
 torch.set_num_threads(1)
 
 
-def _strip(nx=13, ny=4, length=3.0, width=0.6):
-    x, y = np.meshgrid(np.linspace(0, length, nx), np.linspace(0, width, ny), indexing="ij")
-    P = np.stack([x.ravel(), y.ravel(), np.zeros(nx * ny)], 1)
-    F = []
-    for i in range(nx - 1):
-        for j in range(ny - 1):
-            a = i * ny + j
-            F += [[a, a + ny, a + 1], [a + ny, a + ny + 1, a + 1]]
-    return P, np.array(F)
-
-
 def _arcs(angles, twist=0.0):
     """A strip rolled into arcs of the given total angles (radians), optionally twisted: RIMD
     features nearly linear in the angle, vertex coordinates not (sines and cosines)."""
-    P, F = _strip()
+    P, F = strip()
     L = P[:, 0].max()
     out = []
     for k, th in enumerate(angles):
@@ -178,7 +168,7 @@ def _hinged_strips(n=16, hinges=6, amplitude=1.2, seed=0):
     """A strip of 7 units folded at 6 hinges by independent random angles (|angle| <= 1.2 rad).
     The coordinates of a chain of rotations span about 2 directions per hinge and more with their
     products; 12 training meshes do not span them, while the RIMD features of a fold are local."""
-    P, F = _strip(nx=29, ny=3, length=7.0, width=0.5)
+    P, F = strip(nx=29, ny=3, length=7.0, width=0.5)
     rng = np.random.default_rng(seed)
     xs = np.linspace(0, 7.0, hinges + 2)[1:-1]
     out = []
