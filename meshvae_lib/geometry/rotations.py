@@ -337,7 +337,5 @@ def right_jacobian(w: np.ndarray) -> np.ndarray:
     ts = np.where(small, 1.0, t)
     a = np.where(small, 0.5 - t2 / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
     b = np.where(small, 1.0 / 6.0 - t2 / 120.0, (ts - np.sin(ts)) / ts ** 3)
-    W = np.zeros((len(w), 3, 3))
-    W[:, 0, 1], W[:, 0, 2], W[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
-    W[:, 1, 0], W[:, 2, 0], W[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
+    W = hat(w)
     return np.eye(3) - a[:, None, None] * W + b[:, None, None] * (W @ W)

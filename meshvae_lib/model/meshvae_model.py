@@ -289,8 +289,7 @@ class MeshVAEModel:
             raise ValueError(f"iterations must be >= 1, got {iterations}")
         if labels is None and conditions is None and hasattr(vertices, "labels") and self.is_conditional:
             labels = vertices.labels
-        V = np.asarray(getattr(vertices, "vertices", vertices), dtype=np.float64)
-        V = V[None] if V.ndim == 2 else V
+        V = self._vertex_array(vertices)
         Z = np.array(self.encode_meshes(V, conditions, labels, inference="encoder") if z0 is None else z0,
                      dtype=np.float64)
         if Z.shape != (len(V), self.network_.latent_dim):
