@@ -22,7 +22,7 @@ SNIPPETS = {
     "exploration-body": (
         "from meshvae_lib.viewing import LatentExplorer\n"
         "spec = get_spec('exploration-body'); m = course_model('exploration-body')\n"
-        "e = LatentExplorer(m, m.network_.latent_dim, spec.make_collection().faces, dims=range(6), pad_dims=(0, 1))"
+        "e = LatentExplorer(m, m.latent_dim, spec.make_collection().faces, dims=range(6), pad_dims=(0, 1))"
     ),
     "conditional-bodies": "m = course_model('conditional-bodies'); m.generate(1, seed=0, condition={'motion': 'squat'})",
 }

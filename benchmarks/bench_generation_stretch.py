@@ -36,7 +36,7 @@ def measure(coll, name: str, args) -> dict:
     t0 = time.perf_counter()
     saved = Path(args.models or "") / f"{name.replace('/', '_')}_rimd.pt"
     if args.models and saved.exists():
-        from meshvae_lib.model.checkpoint import load_model
+        from meshvae_lib.model.meshvae_model import load_model
 
         model = load_model(saved, coll)
     else:

@@ -21,7 +21,7 @@ import numpy as np
 import torch
 
 from feature_comparison import load_real
-from meshvae_lib.model.checkpoint import load_model
+from meshvae_lib.model.meshvae_model import load_model
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 
@@ -49,7 +49,7 @@ def main() -> None:
     V = np.asarray(coll.vertices, dtype=np.float64)[model.holdout_mask_][: args.meshes]
     model.encode_meshes(V[:1])                       # build the reconstructor's factorisations once
     methods = ["encoder", "gauss-newton"] + (["finite-difference"] if args.finite_difference else [])
-    print(f"{V.shape[1]} vertices, K = {model.network_.n_features}, latent {model.network_.latent_dim},"
+    print(f"{V.shape[1]} vertices, K = {model.n_features}, latent {model.latent_dim},"
           f" {torch.get_num_threads()} thread(s); seconds per mesh, median of {args.repeats} x {len(V)}")
     for method in methods:
         times = []

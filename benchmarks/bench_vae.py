@@ -19,7 +19,8 @@ import torch
 
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import train_vae
-from meshvae_lib.model.vae import MeshVAE, start_step, vae_loss
+from meshvae_lib.model.inplace_grad import start_step
+from meshvae_lib.model.vae import MeshVAE, vae_loss
 
 
 def rimd_k(n_vertices: int) -> int:

@@ -59,7 +59,7 @@ def _real_model(resolution: int):
     c = make_collection("scape", seed=0, resolution=resolution)
     coll = SimpleNamespace(vertices=c.vertices[:12], faces=c.faces, labels={})
     model = MeshVAEModel(config=TrainConfig(epochs=2, progress=False, device="cpu", seed=0)).fit(coll)
-    return (model.decode_latent, model.network_.latent_dim, np.asarray(c.faces), c.vertices[0]), "MeshVAE+RIMD"
+    return (model.decode_latent, model.latent_dim, np.asarray(c.faces), c.vertices[0]), "MeshVAE+RIMD"
 
 
 def _time_moves(explorer, dim: int, moves: int, warmup: int = 3):

@@ -9,7 +9,7 @@ measures it), in the mesh's units, the training time (features + training), the 
 stopping chose and the encoding time per held-out mesh. Every model is evaluated with each
 inference strategy of ``--inference`` (default: the library's default, Gauss-Newton from the
 encoder's means with the analytic Jacobian, and the paper's feed-forward encoder); with
-``--fit-latent N`` also with codes fitted by finite differences (``MeshVAEModel.fit_latent``). Two linear rows close each table: PCA on coordinates and on aligned coordinates,
+``--fit-latent N`` also with codes fitted by finite differences (the "finite-difference" inference). Two linear rows close each table: PCA on coordinates and on aligned coordinates,
 fitted on the training meshes with every direction they span (``evaluation.pca_baseline``).
 
 Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
@@ -86,7 +86,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
             held = evaluate_model(model, coll, held_out_only=True, inference=inference)
             label = kind if inference == "gauss-newton" else f"{kind} ({inference})"
             row = {"collection": name, "features": label, "kind": kind, "inference": inference,
-                   "K": int(model.network_.n_features), "train_error": train["mean_vertex_error"],
+                   "K": int(model.n_features), "train_error": train["mean_vertex_error"],
                    "held_out_error": held["mean_vertex_error"], "relative_error": held["relative_error"],
                    "epochs": int(model.train_epochs_), "seconds": seconds,
                    "encode_seconds_per_mesh": held["seconds_per_mesh"],

@@ -47,8 +47,16 @@ class SynthCollection:
                 raise ValueError(f"label {key!r} must have shape ({n},), got {value.shape}")
             self.labels[key] = value
 
+    def __len__(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_vertices(self) -> int:
+        return self.vertices.shape[1]
+
     @property
     def n_meshes(self) -> int:
+        """``len(collection)`` (the name meshvae_lib's MeshCollection does not have)."""
         return len(self.vertices)
 
     @property

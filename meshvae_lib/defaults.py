@@ -7,10 +7,16 @@ implementation say so, values measured here say where.
 """
 
 # --- option choices ----------------------------------------------------------------------------
-#: feature kinds (the columns of the paper's Table 2; baseline first): ``features.FeatureExtractor``.
-FEATURE_KINDS = ("coords", "aligned", "rimd")
+# (the feature kinds, network architectures and inference methods are registries of their own:
+# ``model.feature_kinds.KINDS``, ``model.networks.ARCHITECTURES``, ``model.inference.METHODS``)
+#: the feature kind a model uses unless told otherwise (the mesh VAE proper: RIMD, Sec. 3).
+DEFAULT_FEATURE_KIND = "rimd"
+#: the network architecture a model trains unless told otherwise (``model.networks``).
+DEFAULT_ARCHITECTURE = "mesh-vae"
 #: RIMD feature layouts: both directions of every edge (the paper's K), or one (``rimd.RIMDEncoder``).
 LAYOUTS = ("paper", "compact")
+#: the RIMD layout unless told otherwise: the paper's.
+DEFAULT_LAYOUT = "paper"
 #: how a sigma_object prior enters the latent cost (``vae.kl_divergence``).
 PRIOR_FORMS = ("exact", "sibling")
 #: the decoder's last activation (``vae.MeshVAE(output=...)``).
@@ -27,7 +33,7 @@ ROTATION_RECOVERY = ("global", "bfs")
 # --- hyperparameter defaults -------------------------------------------------------------------
 #: length of the extra "normal edge", as a fraction of the mean edge length (reference: 0.3).
 NORMAL_EDGE_SCALE = 0.3
-#: features are mapped to [-a, a].
+#: features are mapped to [-a, a] (Eq. 3; the paper's a).
 NORMALIZE_A = 0.9
 #: deviation output sigma = SIGMA_MAX * sigmoid(x).
 SIGMA_MAX = 2.0
@@ -39,8 +45,9 @@ DEFAULT_LATENT = 128
 DEFAULT_LR = 1e-3
 #: slope of the leaky ReLU on internal layers.
 LEAKY_RELU_SLOPE = 0.1
-#: prior deviation of the embedded latent dimensions of the sigma_object model (paper: 0.1).
-EMBEDDING_SIGMA_SMALL = 0.1
+#: prior deviations of the embedding model's first latent dimensions, the embedded ones (paper: 0.1 for
+#: two); the rest are 1 (``train_config.pad_sigma_object``).
+EMBEDDING_SIGMA_OBJECT = (0.1, 0.1)
 #: reconstruction weight of the embedding and exploration models. The paper's 1e6 ("for most tasks") leaves the
 #: latent cost negligible, so sigma_object changes nothing; 1e3 lets it act (measured on the
 #: Dyna-like collection: docs/applications.md, "Embedding").
@@ -64,9 +71,9 @@ NPE_N_NEIGHBORS = 25
 TSNE_PERPLEXITY = 30.0
 #: t-SNE inputs are reduced to this many principal components first.
 TSNE_PCA_DIMS = 50
-#: prior deviations of the exploration model: first two, next two, the rest.
+#: prior deviations of the exploration model's first four latent dimensions; the rest are 1.
 EXPLORATION_SIGMA_OBJECT = (0.1, 0.1, 0.5, 0.5)
-#: browsing range of each explored latent dimension.
+#: browsing range of each explored latent dimension (paper Fig. 8; also the latent explorer's sliders).
 EXPLORATION_RANGE = (-2.0, 2.0)
 #: weight of the extra normal "edge" in the fit of T_i, relative to the cotangent weights
 #: c_ij = cot a + cot b (an equilateral one-ring has c_ij = 1.15).
@@ -82,11 +89,11 @@ DEFAULT_BATCH_SIZE = 32
 #: collections (docs/vae.md, issue 12): on pcow (every 3rd frame) this default (256, random start)
 #: gave 0.109 held-out for raw coordinates, the PCA-initialised network without internal layers 0.022.
 HIDDEN_COORDS = (256,)
-#: half-width a of the normalised range (Eq. 3) used with the PCA initialisation. The paper's 0.9
+#: a of Eq. 3 (the half-width of the normalised range) used with the PCA initialisation. The paper's 0.9
 #: puts training values where tanh is strongly curved; a decoder that is linear before the tanh
 #: then interpolates held-out meshes badly (pcow, coordinates: 0.141 held-out at a = 0.9, 0.031 at
 #: 0.5, 0.022 at 0.3, linear PCA 0.020). Networks trained without the PCA initialisation keep 0.9.
-PCA_FEATURE_RANGE = 0.3
+PCA_NORMALIZE_A = 0.3
 #: early stopping: every this-many-th training mesh is set aside to choose the number of epochs.
 VALIDATION_EVERY = 8
 #: early stopping: stop choosing after this many epochs without a lower validation error.
@@ -103,10 +110,9 @@ LIVE_UPDATE_MAX_MS = 150.0
 PROGRESS_LOG_SECONDS = 10.0
 
 # --- latent inference (model.inference, issue 23) ---------------------------------------------
-#: how MeshVAEModel.encode_meshes picks a mesh's code: "gauss-newton" (the encoder's mean, then
-#: damped Gauss-Newton steps on the vertex error with the analytic Jacobian), "encoder" (the paper's
-#: feed-forward encoder alone), "finite-difference" (fit_latent: Gauss-Newton by forward differences).
-INFERENCE_METHODS = ("gauss-newton", "encoder", "finite-difference")
+#: how MeshVAEModel.encode_meshes finds a mesh's code unless told otherwise (a name of the registry
+#: ``model.inference.METHODS``): the encoder's mean, then damped Gauss-Newton steps on the vertex
+#: error with the analytic Jacobian.
 DEFAULT_INFERENCE = "gauss-newton"
 #: Jacobians per mesh of the Gauss-Newton inference (measured on samba, pdance and pcow: the error
 #: falls by <2% after the fourth).

@@ -97,8 +97,8 @@ EXACT_RESIDUAL_TOL = 1e-10
 EXACT_SELFTEST_TOL = 1e-8
 
 # --- mesh VAE training defaults (measured: docs/vae.md) --------------------------------------
-#: MeshVAEModel.fit_latent: forward-difference step in latent units (the PCA-started latent
-#: dimensions have unit spread over the training meshes).
+#: the "finite-difference" inference (model/inference/vertex_fit.py): forward-difference step in latent
+#: units (the PCA-started latent dimensions have unit spread over the training meshes).
 FIT_LATENT_STEP = 1e-2
 #: PCA initialisation: principal directions with singular value below this fraction of the
 #: largest are not used.
@@ -153,3 +153,7 @@ GN_REL_DECREASE = 1e-4
 #: a latent dimension whose decoded-feature Jacobian column is below this fraction of the largest
 #: takes no part in the fit (a PCA-started decoder leaves the dimensions beyond the data's rank at 0).
 GN_UNUSED_DIM_RTOL = 1e-9
+
+#: FeatureKind.linearize for a kind without an analytic linearisation: forward-difference step,
+#: relative to 1 + the feature row's norm (about the square root of float64's epsilon).
+FD_LINEARIZE_STEP = 1e-7

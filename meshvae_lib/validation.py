@@ -23,6 +23,7 @@ helper                     accepts, returns
 :func:`check_choice`       a string option among its allowed values
 :func:`check_count`        an integer ``>= minimum``
 :func:`check_samples`      a data matrix of at least two finite rows ``(n, k)`` -> float64
+:func:`check_is_fitted`    a fitted estimator (raises :class:`NotFittedError`)
 =========================  ===========================================================
 """
 
@@ -41,6 +42,8 @@ __all__ = [
     "check_choice",
     "check_count",
     "check_samples",
+    "check_is_fitted",
+    "NotFittedError",
 ]
 
 
@@ -113,12 +116,12 @@ def check_vertices(V, name: str = "vertices", *, batch: bool | None = None,
     Raises
     ------
     ValueError
-        A shape other than the accepted ones (the message shows them and the actual shape), or
-        non-finite coordinates when ``finite``.
+        A shape other than the accepted ones (the message shows them and the actual shape; a mesh
+        has at least one vertex), or non-finite coordinates when ``finite``.
     """
     V = np.asarray(V, dtype=np.float64)
     ndims, expected = _vertex_shapes(batch, n_vertices)
-    if (V.ndim not in ndims or V.shape[-1] != 3
+    if (V.ndim not in ndims or V.shape[-1] != 3 or V.shape[-2] == 0
             or (n_vertices is not None and V.shape[-2] != n_vertices)):
         raise ValueError(f"{name} must have shape {expected}, got {V.shape}")
     if finite:
@@ -319,3 +322,24 @@ def check_samples(X, name: str = "X") -> np.ndarray:
     if not np.all(np.isfinite(X)):
         raise ValueError(f"{name} contains NaN or infinite values")
     return X
+
+
+class NotFittedError(ValueError, AttributeError):
+    """An estimator was used before it was fitted (like scikit-learn's: a ``ValueError`` and an
+    ``AttributeError``, so that ``hasattr`` on a fitted-only property answers False)."""
+
+
+def check_is_fitted(obj, attributes, hint: str = "call fit(...) first") -> None:
+    """Raise :class:`NotFittedError` unless ``obj`` has every attribute in ``attributes``.
+
+    Parameters
+    ----------
+    obj : the estimator
+    attributes : str or sequence of str
+        Attributes that :meth:`fit` sets (``"min_"``, ``("network_", "kind_")``).
+    hint : str
+        What to do about it, appended to the message (``"call fit(X) first"``).
+    """
+    names = (attributes,) if isinstance(attributes, str) else tuple(attributes)
+    if not all(hasattr(obj, a) for a in names):
+        raise NotFittedError(f"this {type(obj).__name__} is not fitted yet: {hint}")

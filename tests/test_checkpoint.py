@@ -6,10 +6,13 @@ import numpy as np
 import pytest
 import torch
 
-from meshvae_lib.model.meshvae_model import MeshVAEModel
-from meshvae_lib.model.checkpoint import load_model, write_checkpoint
 from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.model.checkpoint import CHECKPOINT_VERSION
+from meshvae_lib.model.inference import make_inference
+from meshvae_lib.model.inference.vertex_fit import VertexFit
+from meshvae_lib.model.meshvae_model import FITTED_ATTRIBUTES, MeshVAEModel, load_model
 from meshvae_lib.model.train_config import TrainConfig
+from meshvae_lib.validation import NotFittedError
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -61,7 +64,7 @@ def test_checkpoint_round_trip_decodes_identically(model, collection, tmp_path):
     np.testing.assert_array_equal(loaded.sigma_object_, [0.5] + [1.0] * 5)
     np.testing.assert_array_equal(loaded.normalizer_.min_, model.normalizer_.min_)
     assert loaded.history_ == model.history_
-    assert loaded.extractor_.kind == "rimd" and loaded.network_.config() == model.network_.config()
+    assert loaded.feature_kind.name == "rimd" and loaded.network.config() == model.network.config()
     assert not [p for p in tmp_path.iterdir() if p.name != "m.pt"]  # no temporary file left behind
 
 
@@ -84,7 +87,7 @@ def test_bundle_shapes_and_reconstruction(model, collection):
     assert model.decode_latent(z).shape == (n, nv, 3)
     assert model.decode_latent(z[0]).shape == (nv, 3)
     assert model.reconstruct(collection.vertices[:2]).shape == (2, nv, 3)
-    with pytest.raises(ValueError, match=r"\(N, 6\)"):
+    with pytest.raises(ValueError, match=r"\(n_meshes, 6\)"):
         model.decode_latent(np.zeros((2, 5)))
     assert "rimd" in repr(model)
 
@@ -127,7 +130,7 @@ def test_corrupted_truncated_and_foreign_files_give_clear_errors(model, tmp_path
 
 
 def test_unfitted_model_and_missing_labels(collection):
-    with pytest.raises(ValueError, match="not trained"):
+    with pytest.raises(NotFittedError, match="MeshVAEModel is not fitted yet: call fit"):
         MeshVAEModel().decode_latent(np.zeros((1, 4)))
     with pytest.raises(ValueError, match="no label column"):
         MeshVAEModel("aligned", TrainConfig(epochs=1, progress=False), labels=["colour"]).fit(collection)
@@ -137,7 +140,7 @@ def test_conditioning_changes_what_is_generated(collection, tmp_path):
     # a small alpha and latent space make the KL term push the class information into the condition
     cfg = TrainConfig(epochs=300, latent_dim=2, batch_size=32, lr=1e-2, progress=False, alpha=100.0, seed=0)
     model = MeshVAEModel("aligned", cfg, labels=["mode"]).fit(collection)
-    assert model.is_conditional and model.network_.n_conditions == 2
+    assert model.is_conditional and model.n_conditions == 2
     arc = model.generate(6, seed=5, condition={"mode": "arc"})
     s_shape = model.generate(6, seed=5, condition={"mode": "s"})
     V = collection.vertices
@@ -167,9 +170,9 @@ def test_pca_started_model_round_trips_and_is_at_least_as_good_as_its_pca_start(
     from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
 
     model = MeshVAEModel("aligned", TrainConfig(progress=False, epochs=40, init="pca")).fit(collection)
-    assert model.network_.input_rank > 0 and model.normalizer_.a == 0.3 and model.normalizer_.scale == "shared"
+    assert model.network.input_rank > 0 and model.normalizer_.a == 0.3 and model.normalizer_.scale == "shared"
     loaded = load_model(model.save(tmp_path / "d.pt"), collection)
-    assert loaded.network_.input_rank == model.network_.input_rank
+    assert loaded.network.input_rank == model.network.input_rank
     np.testing.assert_array_equal(loaded.encode_meshes(collection), model.encode_meshes(collection))
     np.testing.assert_array_equal(loaded.reconstruct(collection.vertices[:3]), model.reconstruct(collection.vertices[:3]))
     # held-out: close to linear PCA on aligned coordinates (the model starts there)
@@ -187,20 +190,25 @@ def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
     held = np.flatnonzero(model.holdout_mask_)
     V = collection.vertices[held]
     z_enc = model.encode_meshes(V, inference="encoder")
-    z_fit = model.fit_latent(V, iterations=2)
+    z_fit = model.encode_meshes(V, inference=make_inference("finite-difference", iterations=2))
     assert z_fit.shape == z_enc.shape
     e_enc = per_vertex_error(model.decode_latent(z_enc), V)
     e_fit = per_vertex_error(model.decode_latent(z_fit), V)
     assert np.all(e_fit <= e_enc + 1e-12) and np.mean(e_fit) < np.mean(e_enc)
     # only the latent dimensions the decoder uses move
-    used = model.network_.decoder_head.weight.detach().abs().sum(0).numpy() > 0
+    used = model.network.decoder_head.weight.detach().abs().sum(0).numpy() > 0
+    np.testing.assert_array_equal(model.used_latent_dims, np.flatnonzero(used))
     np.testing.assert_array_equal(z_fit[:, ~used], z_enc[:, ~used])
-    res = evaluate_model(model, collection, held_out_only=True, fit_iterations=2)
+    res = evaluate_model(model, collection, held_out_only=True, inference=make_inference("finite-difference", iterations=2))
     assert res["fit_iterations"] == 2 and res["mean_vertex_error"] == pytest.approx(np.mean(e_fit), rel=1e-9)
     with pytest.raises(ValueError, match="iterations"):
-        model.fit_latent(V, iterations=0)
-    with pytest.raises(ValueError, match="z0"):
-        model.fit_latent(V, z0=np.zeros((1, 8)))
+        make_inference("finite-difference", iterations=0)
+    # the same strategy given to the model by name: encode_meshes and reconstruct use it
+    fitting = MeshVAEModel("rimd", TrainConfig(progress=False, epochs=20, latent_dim=8), holdout_every=4,
+                           inference="finite-difference").fit(collection)
+    np.testing.assert_array_equal(fitting.encode_meshes(V), fitting.encode_meshes(V, inference=VertexFit()))
+    with pytest.raises(ValueError, match="inference must be one of"):
+        MeshVAEModel(inference="telepathy").fit(collection)
 
 
 def test_fit_leaves_its_constructor_arguments_and_exposes_the_mesh(collection):
@@ -212,7 +220,7 @@ def test_fit_leaves_its_constructor_arguments_and_exposes_the_mesh(collection):
     for arr in (model.reference_vertices, model.faces):
         with pytest.raises(ValueError, match="read-only"):
             arr[0, 0] = 1
-    with pytest.raises(ValueError, match="not trained yet"):
+    with pytest.raises(NotFittedError, match="not fitted yet"):
         MeshVAEModel().faces
 
 
@@ -232,9 +240,9 @@ def test_network_options_round_trip_through_the_checkpoint(collection, tmp_path)
     cfg = TrainConfig(epochs=4, latent_dim=4, batch_size=8, progress=False, init="random", sigma_floor=1e-4,
                       output="sigmoid", loss="bce")
     model = MeshVAEModel("rimd", cfg, holdout_every=4).fit(collection)
-    assert model.network_.sigma_floor == 1e-4 and model.network_.output == "sigmoid"
+    assert model.network.sigma_floor == 1e-4 and model.network.output == "sigmoid"
     loaded = load_model(model.save(tmp_path / "bce.pt"), collection)
-    assert loaded.network_.config() == model.network_.config()
+    assert loaded.network.config() == model.network.config()
     assert loaded.train_config_.loss == "bce" and loaded.train_config_.output == "sigmoid"
     z = model.sample_latent(5, seed=2)
     np.testing.assert_array_equal(loaded.decode_latent(z), model.decode_latent(z))
@@ -243,10 +251,50 @@ def test_network_options_round_trip_through_the_checkpoint(collection, tmp_path)
     # decoded meshes are in the data's units: the sigmoid's range is mapped back to Eq. 3's
     spread = np.abs(collection.vertices).max()
     assert np.all(np.abs(model.reconstruct(collection.vertices[:3])) < 3 * spread)
-    old = torch.load(tmp_path / "bce.pt", weights_only=True)
-    old["version"] = 1
+    old = _old_format(torch.load(tmp_path / "bce.pt", weights_only=True), version=1)
     for key in ("sigma_floor", "output"):
         del old["network_config"][key]
     torch.save(old, tmp_path / "v1.pt")
     v1 = load_model(tmp_path / "v1.pt")
-    assert v1.network_.sigma_floor == 0.0 and v1.network_.output == "tanh"
+    assert v1.network.sigma_floor == 0.0 and v1.network.output == "tanh"
+
+
+def _old_format(payload: dict, version: int) -> dict:
+    """A format-3 payload written back in the layout of format 1 or 2 (the feature extractor's state,
+    no architecture, epochs or selection, ``feature_range`` for a)."""
+    old = dict(payload, version=version)
+    kind = old.pop("kind")
+    old["extractor"] = {"kind": kind["kind"], "layout": kind["options"].get("layout", "paper"),
+                        "reference_index": old["estimator"]["reference_index"], "reference": kind["reference"],
+                        "faces": kind["faces"], "n_features": kind["n_features"]}
+    for key in ("architecture", "train_epochs", "selection"):
+        del old[key]
+    old["train_config"] = dict(old["train_config"])
+    old["train_config"]["feature_range"] = old["train_config"].pop("a")
+    del old["train_config"]["architecture"]
+    old["estimator"] = {k: v for k, v in old["estimator"].items() if k != "inference"}
+    return old
+
+
+def test_a_loaded_model_has_exactly_the_fitted_attributes_of_a_fitted_one(model, collection, tmp_path):
+    assert set(FITTED_ATTRIBUTES) <= set(vars(model))
+    loaded = load_model(model.save(tmp_path / "m.pt"), collection)
+    # last_inference_ is the report of the latest Gauss-Newton encoding (other tests encoded with
+    # this model), not something fit learns: a loaded model gets one when it encodes
+    assert set(vars(loaded)) == set(vars(model)) - {"last_inference_"}
+    loaded.encode_meshes(collection.vertices[:1])
+    assert set(vars(loaded)) == set(vars(model)) | {"last_inference_"}
+    assert loaded.train_epochs_ == model.train_epochs_ and loaded.selection_ == model.selection_
+    payload = torch.load(tmp_path / "m.pt", weights_only=True)
+    assert payload["version"] == CHECKPOINT_VERSION == 3 and payload["architecture"] == "mesh-vae"
+
+
+def test_files_of_format_2_still_load(model, collection, tmp_path):
+    old = _old_format(torch.load(model.save(tmp_path / "m.pt"), weights_only=True), version=2)
+    torch.save(old, tmp_path / "v2.pt")
+    v2 = load_model(tmp_path / "v2.pt", collection)
+    assert set(vars(v2)) == set(vars(model)) - {"last_inference_"} and v2.selection_ is None
+    assert v2.train_epochs_ == model.history_[-1]["epoch"]
+    z = model.sample_latent(3, seed=4)
+    np.testing.assert_array_equal(v2.decode_latent(z), model.decode_latent(z))
+    np.testing.assert_array_equal(v2.encode_meshes(collection), model.encode_meshes(collection))

@@ -41,10 +41,10 @@ def data(tmp_path_factory):
 
 def test_train_writes_a_loadable_model(data, capsys):
     root, path, model, coll = data
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.meshvae_model import load_model
 
     m = load_model(model, read_collection(path))
-    assert m.network_.latent_dim == 4 and m.config.epochs == 8 and m.extractor_.kind == "rimd"
+    assert m.latent_dim == 4 and m.config.epochs == 8 and m.feature_kind.name == "rimd"
     np.testing.assert_array_equal(np.flatnonzero(m.holdout_mask_), [3, 7, 11, 15])
     np.testing.assert_array_equal(m.sigma_object_, [0.5, 1, 1, 1])
 

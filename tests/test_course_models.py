@@ -75,35 +75,62 @@ def test_the_key_changes_with_anything_that_determines_the_model(monkeypatch):
     assert cm.model_key(TINY) != key
 
 
-def test_code_fingerprint_covers_the_model_layers_not_the_viewers():
+def _copy_of_the_code(tmp_path) -> dict:
+    """A copy of meshvae_lib and data_synth to edit: package name -> folder."""
+    import shutil
+
+    import data_synth
     import meshvae_lib
 
-    root = Path(meshvae_lib.__file__).parent
-    before = cm.code_fingerprint()
-    assert before == cm.code_fingerprint()
-    probe = root / "viewing" / "_fingerprint_probe.py"
-    probe.write_text("x = 1\n")
-    try:
-        assert cm.code_fingerprint() == before  # a viewer change does not invalidate trained models
-    finally:
-        probe.unlink()
-    assert "applications" in cm._CODE_EXCLUDED and not any("training" in e or e == "model" for e in cm._CODE_EXCLUDED)
-    probe = root / "_fingerprint_probe.py"
-    probe.write_text("x = 1\n")
-    try:
-        assert cm.code_fingerprint() != before
-    finally:
-        probe.unlink()
+    roots = {}
+    for package in (meshvae_lib, data_synth):
+        dest = tmp_path / package.__name__
+        shutil.copytree(Path(package.__file__).parent, dest, ignore=shutil.ignore_patterns("__pycache__"))
+        roots[package.__name__] = dest
+    return roots
+
+
+def test_the_code_in_the_key_is_the_import_closure_of_training(tmp_path):
+    from meshvae_lib.course.closure import import_closure
+
+    roots = _copy_of_the_code(tmp_path)
+    closure = import_closure(cm.TRAINING_ENTRY_POINTS, roots)
+    # what training imports, the registries' modules (imported by name) included
+    for module in ("meshvae_lib.model.training", "meshvae_lib.model.vae", "meshvae_lib.geometry.rimd",
+                   "meshvae_lib.model.feature_kinds.rimd", "meshvae_lib.model.feature_kinds.coords",
+                   "meshvae_lib.geometry.reconstruction", "data_synth.bodies", "meshvae_lib.validation"):
+        assert module in closure, module
+    # and nothing that only uses a model
+    for module in ("meshvae_lib.viewing.render", "meshvae_lib.paper.protocol", "meshvae_lib.applications.generation",
+                   "meshvae_lib.geometry.intersections", "meshvae_lib.model.evaluation", "meshvae_lib.cli"):
+        assert module not in closure, module
+    before = cm.code_fingerprint(roots)
+    assert before == cm.code_fingerprint(roots) and len(before) == 64
+    for unrelated in ("meshvae_lib/viewing/render.py", "meshvae_lib/paper/features.py",
+                      "meshvae_lib/geometry/intersections.py", "meshvae_lib/model/evaluation.py"):
+        path = tmp_path / unrelated
+        path.write_text(path.read_text() + "\nPROBE = 1\n")
+        assert cm.code_fingerprint(roots) == before, f"editing {unrelated} changed the key"
+    for related in ("meshvae_lib/geometry/topology.py", "meshvae_lib/model/feature_kinds/rimd.py",
+                    "data_synth/skinning.py"):
+        path = tmp_path / related
+        original = path.read_text()
+        path.write_text(original + "\nPROBE = 1\n")
+        assert cm.code_fingerprint(roots) != before, f"editing {related} kept the key"
+        path.write_text(original)
+    assert cm.code_fingerprint(roots) == cm.code_fingerprint()  # the copy is the installed code
 
 
 def test_code_fingerprint_ignores_comments_and_docstrings_not_code():
+    from meshvae_lib.course.closure import code_without_docstrings
+
     src = '"""Doc."""\nX = 1  # a comment\n\ndef f(a):\n    """What f does."""\n    return a + X\n'
     same = '"""Other doc."""\n# new comment\nX = 1\n\ndef f(a):\n    return a + X  # still the same code\n'
     other = '"""Doc."""\nX = 2\n\ndef f(a):\n    """What f does."""\n    return a + X\n'
-    assert cm._code_without_docstrings(src) == cm._code_without_docstrings(same)
-    assert cm._code_without_docstrings(src) != cm._code_without_docstrings(other)
+    assert code_without_docstrings(src) == code_without_docstrings(same)
+    assert code_without_docstrings(src) != code_without_docstrings(other)
     only_doc = 'def g():\n    """Only a docstring."""\n'
-    assert "Pass" in cm._code_without_docstrings(only_doc)   # still a valid tree
+    assert "Pass" in code_without_docstrings(only_doc)   # still a valid tree
 
 
 def test_course_model_builds_once_then_loads(cache, monkeypatch):

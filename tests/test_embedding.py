@@ -117,17 +117,13 @@ def test_pca_and_tsne_shapes_and_seed(rng):
     np.testing.assert_array_equal(T1, T2)
 
 
-def test_embedding_sigma_object():
-    s = emb.embedding_sigma_object(6)
-    np.testing.assert_array_equal(s, [0.1, 0.1, 1, 1, 1, 1])
+def test_embedding_sigma_object_is_the_default_padded():
+    from meshvae_lib.defaults import EMBEDDING_SIGMA_OBJECT
+    from meshvae_lib.model.train_config import pad_sigma_object
+
+    np.testing.assert_array_equal(pad_sigma_object(EMBEDDING_SIGMA_OBJECT, 6), [0.1, 0.1, 1, 1, 1, 1])
     with pytest.raises(ValueError):
-        emb.embedding_sigma_object(1)
-
-
-def test_vae_embedding_takes_means():
-    mu = np.arange(12.0).reshape(3, 4)
-    Y = emb.vae_embedding(lambda X: (mu, np.ones_like(mu)), None)
-    np.testing.assert_array_equal(Y, mu[:, :2])
+        pad_sigma_object(EMBEDDING_SIGMA_OBJECT, 1)
 
 
 # ---------------------------------------------------------------------------------------------

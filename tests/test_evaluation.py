@@ -36,16 +36,17 @@ class _FakeModel:
     """Reconstructs each mesh shifted by mesh index * 0.1 along z and with vertex 0 off by 1 along x."""
 
     is_conditional = False
+    inference = "encoder"
+    feature_kind = type("K", (), {"name": "coords"})()
 
     def __init__(self, n):
         self.holdout_mask_ = np.arange(n) % 3 == 2
-        self.extractor_ = type("E", (), {"kind": "coords"})()
         self.seen = None
 
     def check_compatible(self, collection):
         pass
 
-    def reconstruct(self, V, labels=None):
+    def reconstruct(self, V, labels=None, inference=None):
         self.seen = V
         out = V.copy()
         out[:, 0, 0] += 1.0

@@ -207,7 +207,7 @@ def test_the_experiments_network_floors_the_deviation_and_train_checks_the_prior
     import torch
 
     d = paper.load_collection(coll, SETTINGS, cache=cache)
-    net = protocol.train_model(d, SETTINGS, cache).network_
+    net = protocol.train_model(d, SETTINGS, cache).network
     assert type(net).__name__ == "MeshVAE" and net.sigma_floor == tol.SIGMA_FLOOR and net.output == "tanh"
     _, s = net.encode(torch.full((2, net.n_features), -1e4))
     assert torch.all(s >= tol.SIGMA_FLOOR)  # the deviation the KL sees is never 0
@@ -227,10 +227,11 @@ def test_the_model_cache_is_keyed_by_the_collections_content():
     other.vertices = other.vertices * 1.1  # a new object, perhaps at a freed one's address: other data
     d = paper.load_collection(other, SETTINGS, cache=cache)
     m2 = protocol.train_model(d, SETTINGS, cache)
-    assert m2 is not m and d.fingerprint != paper.load_collection(_make(), SETTINGS).fingerprint
+    fingerprint = paper.collection_fingerprint
+    assert m2 is not m and fingerprint(d) != fingerprint(paper.load_collection(_make(), SETTINGS))
     relabelled = _make()
     relabelled.labels["shape"] = relabelled.labels["shape"][::-1].copy()
-    assert paper.load_collection(relabelled, SETTINGS).fingerprint != paper.load_collection(_make(), SETTINGS).fingerprint
+    assert fingerprint(paper.load_collection(relabelled, SETTINGS)) != fingerprint(paper.load_collection(_make(), SETTINGS))
     # a callable entry is made once and kept alive by its cache entry (its id cannot be reused)
     made = []
     make = lambda res: made.append(res) or _make(res)  # noqa: E731

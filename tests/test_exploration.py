@@ -38,9 +38,12 @@ def _yaw(deg):
 
 
 def test_sigma_object_and_grid():
-    np.testing.assert_array_equal(ex.exploration_sigma_object(6), [0.1, 0.1, 0.5, 0.5, 1, 1])
+    from meshvae_lib.defaults import EXPLORATION_SIGMA_OBJECT
+    from meshvae_lib.model.train_config import pad_sigma_object
+
+    np.testing.assert_array_equal(pad_sigma_object(EXPLORATION_SIGMA_OBJECT, 6), [0.1, 0.1, 0.5, 0.5, 1, 1])
     with pytest.raises(ValueError):
-        ex.exploration_sigma_object(3)
+        pad_sigma_object(EXPLORATION_SIGMA_OBJECT, 3)
     base = np.arange(5.0)
     Z = ex.latent_grid(base, dims=(2, 3), n=3)
     assert Z.shape == (3, 3, 5)

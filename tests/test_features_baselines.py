@@ -1,11 +1,12 @@
-"""FeatureExtractor (RIMD and the coordinate baselines of Table 2) and ConditionEncoder."""
+"""The feature kinds (RIMD and the coordinate baselines of Table 2), their registry, and ConditionEncoder."""
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from meshvae_lib.geometry.alignment import rigid_align
-from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
+from meshvae_lib.model.conditions import ConditionEncoder
+from meshvae_lib.model.feature_kinds import FEATURE_KINDS, kind_class, kind_from_state, make_kind
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.geometry.topology import edges
 from meshvae_lib.model.train_config import default_hidden
@@ -34,10 +35,10 @@ def grid_collection(n=6, seed=0, nx=6, ny=4):
 @pytest.mark.parametrize("kind", ["rimd", "aligned", "coords"])
 def test_round_trip_meshes_to_rows_to_meshes(kind):
     V, F = grid_collection()
-    ext = FeatureExtractor(kind).fit(V, F)
-    X = ext.transform(V)
-    assert X.shape == (len(V), ext.n_features_) and X.dtype == np.float64
-    back = ext.inverse_transform(X)
+    k = make_kind(kind, V[0], F)
+    X = k.encode(V)
+    assert X.shape == (len(V), k.n_features) and X.dtype == np.float64
+    back = k.decode(X)
     assert back.shape == V.shape
     diag = np.linalg.norm(np.ptp(V[0], axis=0))
     if kind == "coords":
@@ -46,15 +47,20 @@ def test_round_trip_meshes_to_rows_to_meshes(kind):
         np.testing.assert_allclose(back, rigid_align(V, V[0]), atol=1e-12)
     else:  # RIMD has no pose: compare after aligning to the true meshes
         np.testing.assert_allclose(rigid_align(back, V), V, atol=1e-6 * diag)
-    assert ext.inverse_transform(X[1]).shape == V.shape[1:]
+    assert k.decode(X[1:2]).shape == (1,) + V.shape[1:]
 
 
-def test_feature_lengths():
+def test_feature_lengths_and_the_registry():
     V, F = grid_collection(n=2)
     nv, ne = V.shape[1], len(edges(F))
-    assert FeatureExtractor("coords").fit(V, F).n_features_ == 3 * nv
-    assert FeatureExtractor("aligned").fit(V, F).n_features_ == 3 * nv
-    assert FeatureExtractor("rimd").fit(V, F).n_features_ == 6 * nv + 6 * ne == RIMDLayout(F, nv).K
+    assert FEATURE_KINDS == ("coords", "aligned", "rimd")  # the order of Table 2, baseline first
+    assert make_kind("coords", V[0], F).n_features == 3 * nv
+    assert make_kind("aligned", V[0], F).n_features == 3 * nv
+    assert make_kind("rimd", V[0], F).n_features == 6 * nv + 6 * ne == RIMDLayout(F, nv).K
+    assert make_kind("rimd", V[0], F, layout="compact").n_features == 6 * nv + 3 * ne
+    assert make_kind("coords", V[0], F, layout="compact").get_options() == {}  # options a kind lacks are left out
+    for name in FEATURE_KINDS:
+        assert kind_class(name).name == name
 
 
 def test_invariance_to_rigid_motion():
@@ -62,35 +68,89 @@ def test_invariance_to_rigid_motion():
     R = Rotation.from_euler("xyz", [0.7, -1.2, 2.0]).as_matrix()
     moved = V @ R.T + np.array([3.0, -1.0, 0.5])
     for kind, invariant in (("rimd", True), ("aligned", True), ("coords", False)):
-        ext = FeatureExtractor(kind).fit(V, F)
-        diff = np.abs(ext.transform(moved[1:]) - ext.transform(V[1:])).max()
+        k = make_kind(kind, V[0], F)
+        diff = np.abs(k.encode(moved[1:]) - k.encode(V[1:])).max()
         assert (diff < 1e-8) == invariant, (kind, diff)
 
 
 def test_compatibility_checks_and_bad_input():
     V, F = grid_collection(n=2)
-    ext = FeatureExtractor("aligned").fit(V, F)
+    k = make_kind("aligned", V[0], F)
     with pytest.raises(ValueError, match="24 vertices, got 20"):
-        ext.transform(V[:, :20])
+        k.encode(V[:, :20])
     with pytest.raises(ValueError, match="connectivity"):
-        ext.check_compatible(V, F[:, ::-1])
-    with pytest.raises(ValueError, match=r"\(N, 72\)"):
-        ext.inverse_transform(np.zeros((1, 5)))
+        k.check_compatible(V, F[:, ::-1])
+    with pytest.raises(ValueError, match=r"\(n_meshes, 72\)"):
+        k.decode(np.zeros((1, 5)))
     with pytest.raises(ValueError, match="kind must be one of"):
-        FeatureExtractor("voxels").fit(V, F)
-    with pytest.raises(ValueError, match="not fitted"):
-        FeatureExtractor().transform(V)
-    with pytest.raises(ValueError, match="reference_index"):
-        FeatureExtractor("coords", reference_index=5).fit(V, F)
+        make_kind("voxels", V[0], F)
+    with pytest.raises(ValueError, match="reference must have shape"):
+        make_kind("coords", V, F)
+    with pytest.raises(ValueError, match="out of range"):
+        make_kind("coords", V[0, :5], F)
+    with pytest.raises(ValueError, match="read-only"):
+        k.reference[0, 0] = 1.0
 
 
 @pytest.mark.parametrize("kind", ["rimd", "aligned", "coords"])
 def test_state_dict_round_trip(kind):
     V, F = grid_collection(n=3)
-    ext = FeatureExtractor(kind).fit(V, F)
-    copy = FeatureExtractor.from_state_dict(ext.state_dict())
-    np.testing.assert_array_equal(copy.transform(V), ext.transform(V))
-    np.testing.assert_array_equal(copy.inverse_transform(ext.transform(V)), ext.inverse_transform(ext.transform(V)))
+    k = make_kind(kind, V[0], F, layout="compact")
+    copy = kind_from_state(k.state_dict())
+    assert type(copy) is type(k) and copy.get_options() == k.get_options()
+    np.testing.assert_array_equal(copy.encode(V), k.encode(V))
+    np.testing.assert_array_equal(copy.decode(k.encode(V)), k.decode(k.encode(V)))
+
+
+TOY_KIND = '''
+import numpy as np
+from meshvae_lib.model.feature_kinds.base import FeatureKind
+
+
+class EdgeVectorsKind(FeatureKind):
+    """A toy kind: each mesh's vertices relative to the first vertex (translation-free)."""
+
+    name = "toy"
+    options = ("scale",)
+
+    def __init__(self, reference, faces, scale=1.0):
+        super().__init__(reference, faces)
+        self.scale = float(scale)
+
+    @property
+    def n_features(self):
+        return 3 * self.n_vertices
+
+    def _encode(self, V):
+        return ((V - V[:, :1]) * self.scale).reshape(len(V), -1)
+
+    def _decode(self, X):
+        return X.reshape(len(X), -1, 3) / self.scale
+'''
+
+
+def test_a_new_feature_kind_is_one_module_and_one_registry_line(tmp_path, monkeypatch):
+    """What a contributor does to add a kind: write the module, add its line to the registry. The
+    model trains on it, saves and loads it by name, and the command line offers it."""
+    import sys
+
+    from meshvae_lib.geometry.collection import MeshCollection
+    from meshvae_lib.model import feature_kinds
+    from meshvae_lib.model.meshvae_model import MeshVAEModel, load_model
+    from meshvae_lib.model.train_config import TrainConfig
+
+    (tmp_path / "toy_kind.py").write_text(TOY_KIND)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(feature_kinds.KINDS, "toy", "toy_kind:EdgeVectorsKind")   # the one line
+    V, F = grid_collection(n=12)
+    coll = MeshCollection(V, F)
+    model = MeshVAEModel("toy", TrainConfig(epochs=3, latent_dim=3, progress=False), holdout_every=4).fit(coll)
+    assert model.feature_kind.name == "toy" and model.n_features == 3 * V.shape[1]
+    loaded = load_model(model.save(tmp_path / "toy.pt"), coll)
+    assert type(loaded.feature_kind).__name__ == "EdgeVectorsKind" and loaded.feature_kind.scale == 1.0
+    np.testing.assert_array_equal(loaded.reconstruct(V[:2]), model.reconstruct(V[:2]))
+    assert default_hidden("toy", "random") == ()
+    sys.modules.pop("toy_kind", None)
 
 
 def test_default_hidden_layers():

@@ -58,7 +58,7 @@ def test_prior_draws_shape_seed_and_scale():
     np.testing.assert_allclose(z.mean(axis=0), 0.0, atol=0.03)
     np.testing.assert_array_equal(model.sample_latent(5, seed=1), model.sample_latent(5, seed=1))
     assert not np.array_equal(model.sample_latent(5, seed=1), model.sample_latent(5, seed=2))
-    with pytest.raises(ValueError, match="n must be >= 1, got 0"):
+    with pytest.raises(ValueError, match="n must be an integer >= 1, got 0"):
         model.sample_latent(0)
 
 
@@ -82,11 +82,11 @@ def test_nearest_neighbors_against_brute_force(rng):
         gen.nearest_neighbors(Q, D[:, :5])
 
 
-def test_generate_shapes_determinism_and_neighbours():
+def test_nearest_training_meshes_shapes_determinism_and_neighbours():
     coll = _tiny_collection()
     model = _tiny_model(coll)
-    a = gen.generate(model, 4, seed=7, dataset=coll, feature_space="model")
-    b = gen.generate(model, 4, seed=7, dataset=coll, feature_space="model")
+    a = gen.nearest_training_meshes(model, 4, coll, seed=7, feature_space="model")
+    b = gen.nearest_training_meshes(model, 4, coll, seed=7, feature_space="model")
     assert a.vertices.shape == (4, 10, 3) and a.vertices.dtype == np.float64
     assert a.latents.shape == (4, 3)
     np.testing.assert_array_equal(a.vertices, b.vertices)
@@ -99,38 +99,38 @@ def test_generate_shapes_determinism_and_neighbours():
     assert a.dataset_nn_distance.shape == (12,) and np.all(a.dataset_nn_distance > 0)
     assert a.novelty_ratio().shape == (4,)
     np.testing.assert_array_equal(a.nearest_labels["shape"], coll.labels["shape"][a.nearest])
-    c = gen.generate(model, 4, seed=8)
-    assert c.nearest is None and not np.array_equal(c.vertices, a.vertices)
+    np.testing.assert_array_equal(a.vertices, model.generate(4, seed=7))  # the model's own generation
+    assert not np.array_equal(model.generate(4, seed=8), a.vertices)
     assert "| sample |" in a.to_markdown()
     with pytest.raises(ValueError, match="unconditional"):
-        gen.generate(model, 2, condition={"shape": "small"})
+        gen.nearest_training_meshes(model, 2, coll, condition={"shape": "small"})
     with pytest.raises(ValueError, match="feature_space"):
-        gen.generate(model, 2, dataset=coll, feature_space="xyz")
+        gen.nearest_training_meshes(model, 2, coll, feature_space="xyz")
 
 
 @pytest.mark.parametrize("space", ["rimd", "model"])
-def test_generate_with_precomputed_dataset_features_matches(space):
+def test_nearest_training_meshes_with_precomputed_dataset_features_matches(space):
     coll = _tiny_collection()
     model = _tiny_model(coll)
     X = gen.dataset_feature_rows(model, coll, feature_space=space)
     assert X.shape[0] == 12 and X.dtype == np.float64
-    a = gen.generate(model, 5, seed=3, dataset=coll, feature_space=space)
-    b = gen.generate(model, 5, seed=3, dataset=coll, feature_space=space, dataset_features=X)
+    a = gen.nearest_training_meshes(model, 5, coll, seed=3, feature_space=space)
+    b = gen.nearest_training_meshes(model, 5, coll, seed=3, feature_space=space, dataset_features=X)
     np.testing.assert_array_equal(a.nearest, b.nearest)
     np.testing.assert_array_equal(a.distance, b.distance)
     np.testing.assert_array_equal(a.dataset_nn_distance, b.dataset_nn_distance)
     with pytest.raises(ValueError, match=r"dataset_features must be \(12, "):
-        gen.generate(model, 2, dataset=coll, feature_space=space, dataset_features=X[:5])
+        gen.nearest_training_meshes(model, 2, coll, feature_space=space, dataset_features=X[:5])
 
 
-def test_generate_conditional_uses_the_condition():
+def test_nearest_training_meshes_of_a_conditional_model_use_the_condition():
     coll = _tiny_collection()
     model = _tiny_model(coll, labels=("shape",))
-    res = gen.generate(model, 3, seed=1, condition={"shape": "large"})
-    assert res.conditions.shape == (3, model.network_.n_conditions)
+    res = gen.nearest_training_meshes(model, 3, coll, seed=1, condition={"shape": "large"})
+    assert res.conditions.shape == (3, model.n_conditions)
     want = model.condition_vector({"shape": "large"}, n=3)
     np.testing.assert_array_equal(res.conditions, want)
-    other = gen.generate(model, 3, seed=1, condition={"shape": "small"})
+    other = gen.nearest_training_meshes(model, 3, coll, seed=1, condition={"shape": "small"})
     np.testing.assert_array_equal(res.latents, other.latents)  # same prior draws
     assert not np.allclose(res.vertices, other.vertices)  # the condition changes the decoding
 
@@ -141,7 +141,7 @@ def test_condition_agreement_against_a_loop_and_the_chance_level():
     got = gen.condition_agreement(model, coll, "shape", n=5, seed=2)
     want = []
     for v in ("large", "small"):
-        res = gen.generate(model, 5, seed=2, condition={"shape": v}, dataset=coll)
+        res = gen.nearest_training_meshes(model, 5, coll, seed=2, condition={"shape": v})
         want.append(np.mean(res.nearest_labels["shape"] == v))
     np.testing.assert_array_equal(got, want)
     # unconditioned, each mesh's neighbour has exactly one of the values: the shares sum to 1

@@ -9,8 +9,8 @@ from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 from meshvae_lib.geometry.rimd import RIMDEncoder
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline, per_vertex_error
-from meshvae_lib.model.features import CoordinateLinearization
-from meshvae_lib.model.inference import decoder_jacobian, gauss_newton_codes, rigid_fields
+from meshvae_lib.model.feature_kinds.coords import CoordinateLinearization
+from meshvae_lib.model.inference.gauss_newton import decoder_jacobian, gauss_newton_codes, rigid_fields
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.vae import MeshVAE
@@ -111,6 +111,25 @@ def test_coordinate_linearization_is_the_reshape():
     d = np.arange(24.0).reshape(12, 2)
     np.testing.assert_array_equal(lin.jvp(d), d.reshape(4, 3, 2))
     np.testing.assert_array_equal(lin.vjp(lin.jvp(d)), d)
+
+
+def test_a_kind_without_its_own_linearisation_gets_forward_differences():
+    """FeatureKind's default linearize: forward differences of the kind's decoder, against the exact
+    derivative of a decoder that is not linear (x -> x + 0.1 x^2 per coordinate)."""
+    from meshvae_lib.model.feature_kinds.base import FiniteDifferenceLinearization
+
+    def decode(X):
+        return (X + 0.1 * X ** 2).reshape(len(X), -1, 3)
+
+    f = np.linspace(-1.0, 2.0, 12)
+    lin = FiniteDifferenceLinearization(decode, f)
+    np.testing.assert_array_equal(lin.positions, decode(f[None])[0])
+    dF = np.random.default_rng(0).standard_normal((12, 3))
+    dF[:, 1] = 0.0                                              # a zero direction has a zero derivative
+    exact = ((1.0 + 0.2 * f)[:, None] * dF).reshape(4, 3, 3)
+    np.testing.assert_allclose(lin.jvp(dF), exact, rtol=0, atol=1e-5)
+    np.testing.assert_array_equal(lin.jvp(dF)[..., 1], 0.0)
+    assert lin.jvp(dF[:, 0]).shape == (4, 3)
 
 
 # -- the network's part ---------------------------------------------------------------------------
@@ -222,7 +241,7 @@ def test_inference_for_coordinate_kinds_and_a_conditional_model(arcs):
 def test_inference_options_are_checked(arcs, arc_model):
     with pytest.raises(ValueError, match="inference must be one of"):
         arc_model.encode_meshes(arcs.vertices[:2], inference="newton")
-    with pytest.raises(ValueError, match="iterations must be >= 1"):
+    with pytest.raises(ValueError, match="iterations must be an integer >= 1"):
         arc_model.encode_meshes(arcs.vertices[:2], iterations=0)
     mu, sigma = arc_model.encode_meshes(arcs.vertices[:2], inference="encoder", return_sigma=True)
     assert mu.shape == sigma.shape == (2, 8) and np.all(sigma > 0)
@@ -232,7 +251,7 @@ def test_a_code_where_the_decoder_saturates_ends_the_fit_instead_of_failing(arcs
     """Far outside the training meshes every tanh output can saturate: the decoded mesh then no
     longer moves with the code (J = 0; found on notebook 10's bar with 8 training meshes). The fit
     stops at the best code found so far instead of failing on a singular system."""
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.meshvae_model import load_model
 
     saturated = load_model(arc_model.save(tmp_path / "arcs.pt"), arcs)
     with torch.no_grad():

@@ -47,7 +47,8 @@ def test_feature_and_latent_interpolation_use_the_callables(rng):
     W = rng.normal(size=(6, 2))
     encode = lambda X: (X @ W, None)  # noqa: E731  linear "encoder" on (2, 6) inputs
     decode = lambda Z: (Z @ W.T).reshape(-1, 2, 3)  # noqa: E731
-    z, V = itp.interpolate_latent(encode, decode, f_a, f_b, 5)
+    mu, _ = encode(np.stack([f_a, f_b]))
+    z, V = itp.LatentPath(decode, mu[0], mu[1]).steps(5)
     assert z.shape == (5, 2) and V.shape == (5, 2, 3)
     np.testing.assert_allclose(z[0], f_a @ W, atol=1e-12)
     np.testing.assert_allclose(z[-1], f_b @ W, atol=1e-12)

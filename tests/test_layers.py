@@ -38,9 +38,10 @@ def layer_of(parts: tuple[str, ...]) -> str:
     return parts[0]
 
 
-def imported_modules(path: Path) -> list[tuple[int, tuple[str, ...]]]:
-    """(line, module parts under meshvae_lib) of every meshvae_lib import in ``path``."""
-    rel = path.relative_to(LIB).with_suffix("").parts
+def imported_modules(path: Path, lib: Path | None = None) -> list[tuple[int, tuple[str, ...]]]:
+    """(line, module parts under meshvae_lib) of every meshvae_lib import in ``path`` (a module of
+    the library at ``lib``, default the real one)."""
+    rel = path.relative_to(LIB if lib is None else lib).with_suffix("").parts
     package = rel[:-1] if rel[-1] != "__init__" else rel[:-1]
     out = []
     for node in ast.walk(ast.parse(path.read_text(), str(path))):
@@ -90,3 +91,84 @@ def test_the_checker_sees_lazy_relative_and_package_imports(tmp_path, monkeypatc
 def test_every_folder_of_the_library_is_a_layer():
     folders = {p.name for p in LIB.iterdir() if p.is_dir() and not p.name.startswith(("_", "."))}
     assert folders == set(ALLOWED) - {"base"}, f"folders {sorted(folders)} vs layers {sorted(ALLOWED)}"
+
+
+# --- no circle of imports inside a layer ---------------------------------------------------------
+
+
+def module_file(parts: tuple[str, ...], lib: Path) -> Path | None:
+    """The file of module ``meshvae_lib.<parts>`` (a module or a package's ``__init__``), or None
+    for a name that is not a module (``from meshvae_lib.model import MeshVAE``-style names)."""
+    base = lib.joinpath(*parts) if parts else lib
+    for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+        if parts and candidate.is_file():
+            return candidate
+    return None
+
+
+def import_graph(lib: Path) -> dict[Path, set[Path]]:
+    """module file -> the module files of meshvae_lib it imports (every import, lazy ones included)."""
+    graph = {}
+    for path in sorted(lib.rglob("*.py")):
+        targets = set()
+        for _, mod in imported_modules(path, lib):
+            target = module_file(mod, lib)
+            if target is not None and target != path:
+                targets.add(target)
+        graph[path] = targets
+    return graph
+
+
+def circles(graph: dict[Path, set[Path]], lib: Path) -> list[list[str]]:
+    """Every circle of imports among modules of one layer (strongly connected components of more
+    than one module, Tarjan's algorithm), as lists of module paths."""
+    def layer(p):
+        return layer_of(p.relative_to(lib).with_suffix("").parts)
+
+    index, low, on_stack, stack, out, counter = {}, {}, set(), [], [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if layer(w) != layer(v):
+                continue
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(p.relative_to(lib).as_posix() for p in component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_circle_of_imports_inside_a_layer():
+    found = circles(import_graph(LIB), LIB)
+    assert not found, "modules that import each other (directly or round a circle):\n" + "\n".join(map(str, found))
+
+
+def test_the_circle_checker_finds_an_injected_circle(tmp_path):
+    """The test above can fail: two model modules that import each other, one of them lazily."""
+    fake = tmp_path / "meshvae_lib"
+    (fake / "model").mkdir(parents=True)
+    (fake / "model" / "a.py").write_text("from meshvae_lib.model.b import g\n")
+    (fake / "model" / "b.py").write_text("def g():\n    from . import c\n")
+    (fake / "model" / "c.py").write_text("from meshvae_lib.model import a\nfrom meshvae_lib import defaults\n")
+    (fake / "model" / "d.py").write_text("from meshvae_lib.model import a\n")
+    (fake / "defaults.py").write_text("X = 1\n")
+    assert circles(import_graph(fake), fake) == [["model/a.py", "model/b.py", "model/c.py"]]

@@ -13,7 +13,8 @@ from scipy.spatial.transform import Rotation
 
 from data_synth import constants as C
 from data_synth import list_collections, make_collection
-from meshvae_lib.geometry.topology import boundary_loops, edges
+from meshvae_lib.geometry.boundaries import boundary_loops
+from meshvae_lib.geometry.topology import edges
 
 NAMES = [n for n, _ in list_collections()]
 CLOSED = {"scape", "dyna", "jumping", "hand", "face"}

@@ -5,6 +5,7 @@ import pytest
 from geometry_fixtures import grid, icosphere, random_rotation, tube
 
 from meshvae_lib.geometry import topology as T
+from meshvae_lib.geometry import boundaries as B
 
 # two triangles sharing edge (0, 2): a unit square in the z = 0 plane
 SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
@@ -27,8 +28,8 @@ def test_euler_characteristic_and_closed_mesh():
     assert len(V) - len(E) + len(F) == 2  # genus 0
     assert np.all(E[:, 0] < E[:, 1])
     assert len(np.unique(E, axis=0)) == len(E)
-    assert T.boundary_vertices(F).size == 0
-    assert T.boundary_loops(F) == []
+    assert B.boundary_vertices(F).size == 0
+    assert B.boundary_loops(F) == []
 
 
 def test_one_rings_match_a_naive_loop():
@@ -53,12 +54,12 @@ def test_edge_index_and_face_edges():
 
 def test_boundary_loops_of_open_tube_and_grid():
     V, F = tube(8, 3, capped=False)
-    loops = T.boundary_loops(F)
+    loops = B.boundary_loops(F)
     assert len(loops) == 2
     assert sorted(len(lp) for lp in loops) == [8, 8]
-    assert set(np.concatenate(loops).tolist()) == set(T.boundary_vertices(F).tolist())
+    assert set(np.concatenate(loops).tolist()) == set(B.boundary_vertices(F).tolist())
     Vg, Fg = grid(4, 3)
-    (loop,) = T.boundary_loops(Fg)
+    (loop,) = B.boundary_loops(Fg)
     assert len(loop) == 2 * (4 + 3)
     # consecutive loop vertices are mesh edges
     E = T.edges(Fg)

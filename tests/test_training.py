@@ -6,7 +6,8 @@ import torch
 
 from meshvae_lib.model.normalization import FeatureNormalizer
 from meshvae_lib.model.train_config import TrainConfig
-from meshvae_lib.model.training import holdout_mask, pad_sigma_object, resolve_device, train_vae
+from meshvae_lib.model.train_config import pad_sigma_object
+from meshvae_lib.model.training import holdout_mask, resolve_device, train_vae
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 
@@ -144,7 +145,6 @@ def test_divergence_stops_with_a_clear_error():
 
 # --- PCA initialisation and early stopping (issue 12) ---------------------------------------------
 
-from meshvae_lib.model.training import pca_network  # noqa: E402
 from meshvae_lib.model.vae import MeshVAE  # noqa: E402
 
 
@@ -154,11 +154,11 @@ def _in_range(n=30, k=80, rank=5, seed=1, a=0.3):
     return FeatureNormalizer(a=a).fit_transform(X)
 
 
-def test_pca_network_starts_at_the_pca_reconstruction():
+def test_the_pca_start_is_the_pca_reconstruction():
     X = _in_range()
     x = torch.from_numpy(X.astype(np.float32))
     cfg = TrainConfig(latent_dim=40, progress=False)
-    net = pca_network(x, cfg).eval()
+    net = MeshVAE.from_pca(x, cfg).eval()
     assert net.input_rank == 29 and net.config()["input_rank"] == 29  # min(D, N - 1)
     with torch.no_grad():
         mu, sigma = net.encode(x)
@@ -180,7 +180,7 @@ def test_pca_network_starts_at_the_pca_reconstruction():
     with torch.no_grad():
         np.testing.assert_allclose(net.encode(shifted)[0].numpy(), mu[:3].numpy(), atol=3e-3)  # float32
     with pytest.raises(ValueError, match="internal layers"):
-        pca_network(x, TrainConfig(hidden=(8,)))
+        MeshVAE.from_pca(x, TrainConfig(hidden=(8,)))
     with pytest.raises(ValueError, match="input_rank"):
         MeshVAE(10, 4, input_rank=11)
 
@@ -189,9 +189,9 @@ def test_pca_start_chooses_the_epochs_by_early_stopping_on_training_rows():
     X = _in_range(n=40)
     assert TrainConfig().uses_pca_init() and TrainConfig().resolved_early_stopping()  # the library's default
     paper = TrainConfig(init="random")  # the paper's training: random start, a = 0.9, all epochs
-    assert not paper.uses_pca_init() and not paper.resolved_early_stopping() and paper.resolved_feature_range() == 0.9
+    assert not paper.uses_pca_init() and not paper.resolved_early_stopping() and paper.resolved_a() == 0.9
     cfg = TrainConfig(epochs=50, latent_dim=8, progress=False, eval_every=5, patience=20, init="pca")
-    assert cfg.uses_pca_init() and cfg.resolved_early_stopping() and cfg.resolved_feature_range() == 0.3
+    assert cfg.uses_pca_init() and cfg.resolved_early_stopping() and cfg.resolved_a() == 0.3
     res = train_vae(X, config=cfg, val_features=X[:2])
     sel = res.selection
     assert sel["validation_rows"] == [7, 15, 23, 31, 39]  # every 8th training row
@@ -216,7 +216,7 @@ def test_zero_chosen_epochs_returns_the_initialisation_with_an_epoch_0_record():
     cfg = TrainConfig(epochs=30, latent_dim=6, progress=False, lr=1.0, eval_every=5, patience=10, init="pca")  # lr 1: ruins it
     res = train_vae(X, config=cfg)
     assert res.epochs == 0 and len(res.history) == 1 and res.history[0]["epoch"] == 0
-    init = pca_network(torch.from_numpy(X.astype(np.float32)), cfg)
+    init = MeshVAE.from_pca(torch.from_numpy(X.astype(np.float32)), cfg)
     assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), init.state_dict().values()))
     assert res.history[0]["total"] == pytest.approx(res.history[0]["reconstruction"] + res.history[0]["kl"], rel=1e-6)
 
@@ -226,13 +226,13 @@ def test_which_networks_get_the_pca_start_and_new_config_checks():
     assert not TrainConfig(sigma_object=(0.1,)).uses_pca_init()
     assert not TrainConfig(init="random").uses_pca_init()
     assert not TrainConfig().uses_pca_init(n_conditions=2)
-    assert TrainConfig(hidden=(8,)).resolved_feature_range() == 0.9  # the paper's a
+    assert TrainConfig(hidden=(8,)).resolved_a() == 0.9  # the paper's a
     assert not TrainConfig(hidden=(8,)).resolved_early_stopping()
-    assert TrainConfig(feature_range=0.5).resolved_feature_range() == 0.5
+    assert TrainConfig(a=0.5).resolved_a() == 0.5
     X = _data(n=20, k=30)
     res = train_vae(X, config=TrainConfig(epochs=3, hidden=(8,), progress=False))
     assert res.selection is None and res.epochs == 3 and res.model.input_rank == 0
-    for bad in (dict(init="zeros"), dict(feature_range=1.0), dict(validation_every=1), dict(patience=0)):
+    for bad in (dict(init="zeros"), dict(a=1.0), dict(validation_every=1), dict(patience=0)):
         with pytest.raises(ValueError):
             TrainConfig(**bad)
     with pytest.raises(ValueError, match="early stopping"):
@@ -242,7 +242,7 @@ def test_which_networks_get_the_pca_start_and_new_config_checks():
 def test_bce_loss_by_hand_on_a_tiny_batch():
     """loss="bce": targets mapped from Eq. 3's [-0.9, 0.9] to [0.1, 0.9], cross-entropy summed over the
     features and averaged over the meshes, the logged MSE back in Eq. 3 units."""
-    from meshvae_lib.model.training import _evaluate, from_output_range, to_output_range
+    from meshvae_lib.model.training import _Loss, from_output_range, to_output_range
 
     cfg = TrainConfig(loss="bce", output="sigmoid", init="random", progress=False, latent_dim=2)
     x = torch.tensor([[-0.9, 0.0, 0.9], [0.9, 0.0, -0.9]])
@@ -257,7 +257,7 @@ def test_bce_loss_by_hand_on_a_tiny_batch():
     ln = np.log
     row1 = -(0.1 * ln(0.2) + 0.9 * ln(0.8)) - ln(0.5) - (0.9 * ln(0.6) + 0.1 * ln(0.4))
     row2 = -(0.9 * ln(0.2) + 0.1 * ln(0.8)) - ln(0.5) - (0.1 * ln(0.6) + 0.9 * ln(0.4))
-    got = _evaluate(net, x, None, cfg, None)
+    got = _Loss(cfg, None, cfg.resolved_a()).evaluate(net, x, None)
     assert got["val_reconstruction"] == pytest.approx((row1 + row2) / 2, rel=1e-5) == pytest.approx(2.3230, rel=1e-4)
     assert got["val_kl"] == pytest.approx(0.0, abs=1e-6)
     assert got["val_total"] == pytest.approx(got["val_reconstruction"] + got["val_kl"], rel=1e-6)
@@ -291,7 +291,7 @@ def test_network_options_come_from_the_config_and_are_checked():
     res = train_vae(X, config=TrainConfig(epochs=2, progress=False, sigma_floor=1e-3, init="random"))
     assert res.model.sigma_floor == 1e-3 and res.model.output == "tanh"
     assert TrainConfig(sigma_floor=1e-3).uses_pca_init()  # the floor keeps the PCA start (tanh output)
-    assert pca_network(torch.from_numpy(X.astype(np.float32)), TrainConfig(sigma_floor=1e-3)).sigma_floor == 1e-3
+    assert MeshVAE.from_pca(torch.from_numpy(X.astype(np.float32)), TrainConfig(sigma_floor=1e-3)).sigma_floor == 1e-3
     for bad in (dict(loss="bce"), dict(loss="l1"), dict(output="relu"), dict(sigma_floor=-1.0)):
         with pytest.raises(ValueError):
             TrainConfig(**bad)

@@ -80,3 +80,36 @@ def test_finite_choice_count():
             check_count(bad, "n")
     with pytest.raises(ValueError, match=r"n_steps must be an integer >= 2, got 1"):
         check_count(1, "n_steps", minimum=2)
+
+
+def test_check_is_fitted_raises_one_not_fitted_error():
+    from meshvae_lib.applications.embedding import NeighborhoodPreservingEmbedding
+    from meshvae_lib.model.conditions import ConditionEncoder
+    from meshvae_lib.model.evaluation import CoordinatePCA
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.model.normalization import FeatureNormalizer
+    from meshvae_lib.validation import NotFittedError, check_is_fitted
+
+    class Thing:
+        pass
+
+    t = Thing()
+    with pytest.raises(NotFittedError, match=r"this Thing is not fitted yet: call fit\(X\) first"):
+        check_is_fitted(t, ("a_", "b_"), "call fit(X) first")
+    t.a_ = t.b_ = 1
+    check_is_fitted(t, ("a_", "b_"))
+    # a ValueError and an AttributeError (as scikit-learn's): hasattr on a fitted-only property is False
+    assert issubclass(NotFittedError, ValueError) and issubclass(NotFittedError, AttributeError)
+    assert not hasattr(MeshVAEModel(), "latent_dim")
+    calls = [lambda: MeshVAEModel().faces, lambda: FeatureNormalizer().transform(np.zeros((1, 2))),
+             lambda: ConditionEncoder(["x"]).transform({"x": np.zeros(1)}),
+             lambda: CoordinatePCA().transform(np.zeros((1, 3, 3))),
+             lambda: NeighborhoodPreservingEmbedding().transform(np.zeros((2, 3)))]
+    for call in calls:
+        with pytest.raises(NotFittedError, match="is not fitted yet"):
+            call()
+
+
+def test_an_empty_mesh_is_refused():
+    with pytest.raises(ValueError, match=r"V must have shape \(n_vertices, 3\), got \(0, 3\)"):
+        check_vertices(np.zeros((0, 3)), "V", batch=False)

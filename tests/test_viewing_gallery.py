@@ -21,7 +21,7 @@ def test_the_most_deformed_mesh_of_each_group_in_order_of_appearance():
     assert gallery_indices(V, 2, groups).tolist() == [1, 2]
     with pytest.raises(ValueError, match=r"one label per mesh \(6\), got shape \(5,\)"):
         gallery_indices(V, 2, groups[:5])
-    with pytest.raises(ValueError, match="n_panels must be >= 1, got 0"):
+    with pytest.raises(ValueError, match="n_panels must be an integer >= 1, got 0"):
         gallery_indices(V, 0)
 
 

@@ -106,7 +106,7 @@ def test_render_mesh_validates(sphere):
     ax = Figure().add_subplot()
     with pytest.raises(ValueError, match=r"\(5, 2\)"):
         render_mesh(ax, np.zeros((5, 2)), F)
-    with pytest.raises(ValueError, match="has 3 vertices"):
+    with pytest.raises(ValueError, match="out of range, there are 3 vertices"):
         render_mesh(ax, np.zeros((3, 3)), F)
 
 

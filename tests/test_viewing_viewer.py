@@ -74,7 +74,7 @@ def test_constructor_validates(sphere):
         MeshViewer([V, V[:5]], F, mode="threejs")
     with pytest.raises(ValueError, match="1 titles for 2 meshes"):
         MeshViewer([V, V], F, titles=["x"], mode="threejs")
-    with pytest.raises(ValueError, match="F indexes vertices"):
+    with pytest.raises(ValueError, match="F: vertex index .* is out of range"):
         MeshViewer(V[:5], F, mode="threejs")
     with pytest.raises(ValueError, match=r"values must have shape \(162,\) or \(1, 162\)"):
         MeshViewer(V, F, values=np.zeros(3), mode="threejs")

@@ -9,47 +9,26 @@ precision-recall curve: ours 0.5168 > t-SNE 0.4961 > PCA 0.2272 > NPE 0.1391.
 Public names
 ------------
 ``NeighborhoodPreservingEmbedding`` (our implementation; no maintained Python package has it),
-``npe_embedding``, ``pca_embedding``, ``tsne_embedding``, ``vae_embedding``,
-``embedding_sigma_object``. Their retrieval scores: :mod:`~meshvae_lib.applications.retrieval`.
+``pca_embedding``, ``tsne_embedding``. The mesh VAE's embedding is the first encoder means of the
+sigma_object model (``model.encode_meshes(coll)[:, :2]``; its prior: ``defaults.EMBEDDING_SIGMA_OBJECT``
+padded by ``train_config.pad_sigma_object``). Their retrieval scores:
+:mod:`~meshvae_lib.applications.retrieval`.
 """
 
 from __future__ import annotations
-
-from typing import Callable, Sequence
 
 import numpy as np
 import scipy.linalg
 
 from meshvae_lib import defaults as hp
 from meshvae_lib import tolerances as tol
-from meshvae_lib.validation import check_samples
+from meshvae_lib.validation import check_is_fitted, check_rows, check_samples
 
 __all__ = [
     "NeighborhoodPreservingEmbedding",
-    "npe_embedding",
     "pca_embedding",
     "tsne_embedding",
-    "vae_embedding",
-    "embedding_sigma_object",
 ]
-
-
-def embedding_sigma_object(latent_dim: int, n_embedded: int = 2) -> np.ndarray:
-    """The prior deviations of the paper's embedding model (Sec. 5.4).
-
-    Returns
-    -------
-    sigma_object : (latent_dim,) float64
-        ``defaults.EMBEDDING_SIGMA_SMALL`` (0.1) for the first ``n_embedded`` dimensions, 1 for
-        the rest.
-    """
-    if int(latent_dim) < int(n_embedded) or int(n_embedded) < 1:
-        raise ValueError(
-            f"need latent_dim >= n_embedded >= 1, got latent_dim={latent_dim}, n_embedded={n_embedded}"
-        )
-    s = np.ones(int(latent_dim), dtype=np.float64)
-    s[: int(n_embedded)] = hp.EMBEDDING_SIGMA_SMALL
-    return s
 
 
 def _knn_indices(X: np.ndarray, k: int) -> np.ndarray:
@@ -175,21 +154,13 @@ class NeighborhoodPreservingEmbedding:
 
     def transform(self, X) -> np.ndarray:
         """Project ``X : (n_samples, n_features)`` to ``(n_samples, n_components)`` float64."""
-        X = np.asarray(X, dtype=np.float64)
-        if X.ndim != 2 or X.shape[1] != self.mean_.shape[0]:
-            raise ValueError(
-                f"X must have shape (n_samples, {self.mean_.shape[0]}), got {X.shape}"
-            )
+        check_is_fitted(self, "components_", "call fit(X) first")
+        X = check_rows(X, "X", self.mean_.shape[0], single=False)
         return (X - self.mean_) @ self.components_
 
     def fit_transform(self, X) -> np.ndarray:
         """``fit(X).transform(X)``."""
         return self.fit(X).transform(X)
-
-
-def npe_embedding(X, n_components: int = 2, n_neighbors: int = hp.NPE_N_NEIGHBORS) -> np.ndarray:
-    """NPE embedding (deterministic), ``X : (n, d)`` -> ``(n, n_components)`` float64."""
-    return NeighborhoodPreservingEmbedding(n_components, n_neighbors).fit_transform(X)
 
 
 def pca_embedding(X, n_components: int = 2, seed: int = 0) -> np.ndarray:
@@ -226,31 +197,3 @@ def tsne_embedding(
     perp = float(min(perplexity, max(1.0, (n - 1) / 3.0)))
     ts = TSNE(n_components=n_components, perplexity=perp, init="pca", random_state=seed)
     return ts.fit_transform(X).astype(np.float64)
-
-
-def vae_embedding(encode: Callable[[np.ndarray], np.ndarray], X, dims: Sequence[int] = (0, 1)) -> np.ndarray:
-    """Embedding by a trained (sigma_object) mesh VAE: the chosen dimensions of the encoder means.
-
-    Parameters
-    ----------
-    encode : callable
-        Maps model inputs ``X`` to encoder means ``(n, latent_dim)`` (e.g. a model bundle's
-        ``encode`` method; a returned ``(mu, sigma)`` tuple is accepted too).
-    X : array
-        Whatever ``encode`` takes (features or meshes).
-    dims : sequence of int
-        Latent dimensions to keep (the paper: the first two, those with sigma_object = 0.1).
-
-    Returns
-    -------
-    Y : (n, len(dims)) float64
-    """
-    mu = encode(X)
-    if isinstance(mu, tuple):
-        mu = mu[0]
-    if hasattr(mu, "detach"):
-        mu = mu.detach().cpu().numpy()
-    mu = np.asarray(mu, dtype=np.float64)
-    if mu.ndim != 2 or max(dims) >= mu.shape[1]:
-        raise ValueError(f"encode must return (n, latent_dim >= {max(dims) + 1}), got {mu.shape}")
-    return mu[:, list(dims)]

@@ -1,6 +1,7 @@
 """Synthesis-based exploration of the shape space (paper Sec. 5.5, Fig. 8).
 
 The paper trains the extended mesh VAE on SCAPE with ``sigma_object = (0.1, 0.1, 0.5, 0.5, 1, ...)``
+(``defaults.EXPLORATION_SIGMA_OBJECT``, padded with ones by ``train_config.pad_sigma_object``)
 so that the first dimensions capture the dominant deformations, then browses the latent space in
 two levels: a grid over dimensions 1-2 in [-2, 2] (the others at 0), and, with dimensions 1-2 fixed
 at a chosen point, a grid over dimensions 3-4. It reads off what each dimension controls: height
@@ -26,9 +27,9 @@ import numpy as np
 from meshvae_lib import defaults as hp
 from meshvae_lib.geometry.alignment import rigid_transform
 from meshvae_lib.model.evaluation import per_vertex_error
+from meshvae_lib.validation import check_rows, check_vertices
 
 __all__ = [
-    "exploration_sigma_object",
     "latent_grid",
     "explore",
     "ExplorationGrid",
@@ -43,19 +44,6 @@ __all__ = [
 
 #: names returned by ``measure_humanoid``, in order.
 HUMANOID_MEASUREMENTS = ("height", "support", "arm_height", "facing")
-
-
-def exploration_sigma_object(latent_dim: int) -> np.ndarray:
-    """The paper's exploration prior: (0.1, 0.1, 0.5, 0.5, 1, ..., 1), shape (latent_dim,) float64."""
-    head = np.asarray(hp.EXPLORATION_SIGMA_OBJECT, dtype=np.float64)
-    if int(latent_dim) < head.size:
-        raise ValueError(f"latent_dim must be at least {head.size}, got {latent_dim}")
-    return np.concatenate([head, np.ones(int(latent_dim) - head.size)])
-
-
-def _latent_dim(model) -> int:
-    net = getattr(model, "network_", None)
-    return int(net.latent_dim if net is not None else model.latent_dim)
 
 
 def latent_grid(base, dims: Sequence[int] = (0, 1), values_a=None, values_b=None, n: int = 5,
@@ -122,7 +110,7 @@ def explore(model, dims: Sequence[int] = (0, 1), base=None, n: int = 5,
     -------
     ExplorationGrid
     """
-    D = _latent_dim(model)
+    D = model.latent_dim
     base = np.zeros(D) if base is None else np.asarray(base, dtype=np.float64)
     if base.shape != (D,):
         raise ValueError(f"base must have shape ({D},), got {base.shape}")
@@ -155,9 +143,7 @@ def humanoid_regions(V_rest, up: int = 1, left: int = 0, foot_fraction: float = 
     dict with ``left_foot``, ``right_foot``, ``left_hand``, ``right_hand``, ``torso``: int64 index
     arrays (each non-empty), and ``up``, ``left``, ``forward`` axis indices.
     """
-    V = np.asarray(V_rest, dtype=np.float64)
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise ValueError(f"V_rest must be (n_vertices, 3), got {V.shape}")
+    V = check_vertices(V_rest, "V_rest", batch=False)
     forward = 3 - up - left
     if sorted((up, left, forward)) != [0, 1, 2]:
         raise ValueError(f"up and left must be two distinct axes in 0..2, got up={up}, left={left}")
@@ -203,11 +189,9 @@ def measure_humanoid(V, regions: dict) -> dict:
     -------
     dict name -> (N,) float64 (floats for a single mesh), names as ``HUMANOID_MEASUREMENTS``.
     """
-    V = np.asarray(V, dtype=np.float64)
+    V = check_vertices(V, "V")
     single = V.ndim == 2
     Vb = V[None] if single else V
-    if Vb.ndim != 3 or Vb.shape[-1] != 3:
-        raise ValueError(f"V must be (n_vertices, 3) or (N, n_vertices, 3), got {V.shape}")
     up, left, fwd = regions["up"], regions["left"], regions["forward"]
     y = Vb[..., up]
     base = y.min(axis=1)
@@ -242,9 +226,7 @@ def latent_measurement_correlation(Z, measurements: dict) -> tuple[np.ndarray, l
     C : (D, n_measurements) float64 in [-1, 1]; 0 where either side is constant
     names : list of the measurement names (the columns of C)
     """
-    Z = np.asarray(Z, dtype=np.float64)
-    if Z.ndim != 2:
-        raise ValueError(f"Z must be (N, D), got {Z.shape}")
+    Z = check_rows(Z, "Z", single=False)
     names = list(measurements)
     M = np.column_stack([np.asarray(measurements[k], dtype=np.float64) for k in names])
     if M.shape[0] != Z.shape[0]:
@@ -324,7 +306,7 @@ def dimension_effects(model, measure: Callable[[np.ndarray], dict], dims: Sequen
     -------
     DimensionEffects
     """
-    D = _latent_dim(model)
+    D = model.latent_dim
     base = np.zeros(D) if base is None else np.asarray(base, dtype=np.float64)
     dims = [int(d) for d in dims]
     if any(not 0 <= d < D for d in dims):
@@ -370,7 +352,7 @@ def dimension_displacement(model, dims: Sequence[int] | None = None, base=None,
     -------
     (n_dims,) float64, >= 0.
     """
-    D = _latent_dim(model)
+    D = model.latent_dim
     dims = list(range(D)) if dims is None else [int(d) for d in dims]
     if any(not 0 <= d < D for d in dims):
         raise ValueError(f"dims must lie in [0, {D}), got {dims}")

@@ -7,14 +7,15 @@ it together with a chosen condition (a body shape, a motion).
 
 To show that the network does not merely memorise its training set, the paper finds for every
 generated mesh its nearest neighbour in the training set by Euclidean distance in RIMD feature
-space (Sec. 5.2, following Gao et al. 2016) and shows the two side by side. ``generate`` does the
-same and, so that "near" has a scale, also reports the typical distance between a training mesh and
-its nearest *other* training mesh (``dataset_nn_distance``): a generated mesh much closer to a
-training mesh than that would be a copy.
+space (Sec. 5.2, following Gao et al. 2016) and shows the two side by side.
+``nearest_training_meshes`` does the same and, so that "near" has a scale, also reports the
+typical distance between a training mesh and its nearest *other* training mesh
+(``dataset_nn_distance``): a generated mesh much closer to a training mesh than that would be a
+copy.
 
-Public names: ``generate``, ``GenerationResult``, ``nearest_neighbors``, ``dataset_feature_rows``,
-``condition_agreement``. (Meshes alone, without the comparison: ``MeshVAEModel.generate``; prior
-draws: ``MeshVAEModel.sample_latent``.)
+Public names: ``nearest_training_meshes``, ``GenerationResult``, ``nearest_neighbors``,
+``dataset_feature_rows``, ``condition_agreement``. (Meshes alone, without the comparison:
+``MeshVAEModel.generate``; prior draws: ``MeshVAEModel.sample_latent``.)
 """
 
 from __future__ import annotations
@@ -23,9 +24,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from meshvae_lib.defaults import DEFAULT_LAYOUT
 from meshvae_lib.tolerances import DUPLICATE_DISTANCE_RTOL
+from meshvae_lib.validation import check_choice, check_count, check_vertices
 
-__all__ = ["nearest_neighbors", "dataset_feature_rows", "generate", "GenerationResult", "condition_agreement"]
+__all__ = ["nearest_neighbors", "dataset_feature_rows", "nearest_training_meshes", "GenerationResult",
+           "condition_agreement", "FEATURE_SPACES"]
+
+#: the spaces nearest neighbours are searched in: RIMD features in the paper's layout (Sec. 5.2's
+#: distance, whatever the model's own features and layout), or the model's own feature rows.
+FEATURE_SPACES = ("rimd", "model")
 
 
 def nearest_neighbors(queries, dataset, chunk: int = 256, exclude_self: bool = False):
@@ -94,7 +102,7 @@ class GenerationResult:
         nearest-neighbour distance (exact duplicates in the training set left out) (about 1: as new as a training mesh is to the others; near 0: a
         copy)."""
         if self.distance is None or self.dataset_nn_distance is None:
-            raise ValueError("no nearest neighbours were computed (generate(..., dataset=None))")
+            raise ValueError("no nearest neighbours were computed")
         d = self.dataset_nn_distance
         d = d[d > DUPLICATE_DISTANCE_RTOL * max(float(d.max()), 1e-300)]  # exact duplicates (shared rest frames) say nothing
         return self.distance / (np.median(d) if d.size else np.nan)
@@ -122,17 +130,13 @@ class GenerationResult:
         return "\n".join(lines)
 
 
-def _check_feature_space(feature_space: str) -> None:
-    if feature_space not in ("rimd", "model"):
-        raise ValueError(f"feature_space must be 'rimd' or 'model', got {feature_space!r}")
-
-
 def _feature_rows(model, V: np.ndarray, feature_space: str) -> np.ndarray:
-    if feature_space == "rimd":
+    if feature_space == "rimd":  # the paper's distance: its layout, whatever the model's (DEFAULT_LAYOUT)
         from meshvae_lib.geometry.rimd import rimd_features
 
-        return np.asarray(rimd_features(model.reference_vertices, V, model.faces), dtype=np.float64).reshape(len(V), -1)
-    return np.asarray(model.extractor_.transform(V), dtype=np.float64).reshape(len(V), -1)
+        rows = rimd_features(model.reference_vertices, V, model.faces, layout=DEFAULT_LAYOUT)
+        return np.asarray(rows, dtype=np.float64).reshape(len(V), -1)
+    return model.feature_kind.encode(V)
 
 
 def dataset_feature_rows(model, dataset, feature_space: str = "rimd") -> np.ndarray:
@@ -140,39 +144,38 @@ def dataset_feature_rows(model, dataset, feature_space: str = "rimd") -> np.ndar
 
     Parameters
     ----------
-    model : a trained ``checkpoint.MeshVAEModel``
+    model : a trained ``MeshVAEModel``
     dataset : a collection (``vertices (M, n_vertices, 3)``) or its vertices
-    feature_space : "rimd" or "model", as in :func:`generate`
+    feature_space : one of :data:`FEATURE_SPACES`, as in :func:`nearest_training_meshes`
 
     Returns
     -------
-    X : (M, K) float64, to pass to ``generate(..., dataset_features=X)``
+    X : (M, K) float64, to pass to ``nearest_training_meshes(..., dataset_features=X)``
     """
-    _check_feature_space(feature_space)
-    D = np.asarray(getattr(dataset, "vertices", dataset), dtype=np.float64)
-    if D.ndim != 3 or D.shape[-1] != 3:
-        raise ValueError(f"dataset must be (M, n_vertices, 3) meshes, got {D.shape}")
+    check_choice(feature_space, FEATURE_SPACES, "feature_space")
+    D = check_vertices(getattr(dataset, "vertices", dataset), "dataset", batch=True)
     return _feature_rows(model, D, feature_space)
 
 
-def generate(
-    model, n: int, seed: int = 0, condition: dict | None = None, dataset=None, feature_space: str = "rimd",
+def nearest_training_meshes(
+    model, n: int, dataset, seed: int = 0, condition: dict | None = None, feature_space: str = "rimd",
     dataset_features=None,
 ) -> GenerationResult:
-    """Generate ``n`` meshes from the prior and find their nearest training meshes (Sec. 5.2).
+    """Generate ``n`` meshes from the prior (``model.generate``) and find their nearest training
+    meshes (Sec. 5.2).
 
     Parameters
     ----------
-    model : a trained ``checkpoint.MeshVAEModel`` (any feature kind)
+    model : a trained ``MeshVAEModel`` (any feature kind)
     n : int >= 1
     seed : int, seeds the prior draws (and the unset condition columns)
     condition : dict column -> value, for a conditional model (Sec. 4.3), e.g. ``{"shape": "s3"}``;
         columns left out take the values of random training meshes
     dataset : the training collection (``vertices (M, n_vertices, 3)``, optional ``labels``) or
-        its (M, n_vertices, 3) vertices; None skips the nearest-neighbour search
-    feature_space : "rimd" (the paper's: RIMD features relative to the model's reference mesh,
-        whatever features the model itself uses) or "model" (the model's own, unnormalised
-        feature rows, e.g. aligned coordinates)
+        its (M, n_vertices, 3) vertices
+    feature_space : "rimd" (the paper's: RIMD features in the paper's layout relative to the
+        model's reference mesh, whatever features and layout the model itself uses) or "model" (the
+        model's own, unnormalised feature rows, e.g. aligned coordinates)
     dataset_features : (M, K) float64 or None, the dataset's rows from
         :func:`dataset_feature_rows` (same ``feature_space``); saves recomputing them on every call
 
@@ -180,16 +183,12 @@ def generate(
     -------
     GenerationResult
     """
-    if int(n) < 1:
-        raise ValueError(f"n must be >= 1, got {n}")
-    _check_feature_space(feature_space)
-    V, z, cond = model.generate(int(n), seed=seed, condition=condition, return_latents=True)
+    n = check_count(n, "n", minimum=1)
+    check_choice(feature_space, FEATURE_SPACES, "feature_space")
+    D = check_vertices(getattr(dataset, "vertices", dataset), "dataset", batch=True,
+                       n_vertices=len(model.reference_vertices))
+    V, z, cond = model.generate(n, seed=seed, condition=condition, return_latents=True)
     result = GenerationResult(latents=z, vertices=V, conditions=cond)
-    if dataset is None:
-        return result
-    D = np.asarray(getattr(dataset, "vertices", dataset), dtype=np.float64)
-    if D.ndim != 3 or D.shape[1:] != V.shape[1:]:
-        raise ValueError(f"dataset must be (M, {V.shape[1]}, 3) meshes, got {D.shape}")
     Xg = _feature_rows(model, V, feature_space)
     if dataset_features is None:
         Xd = _feature_rows(model, D, feature_space)
@@ -234,7 +233,7 @@ def condition_agreement(model, dataset, column: str, values=None, n: int = 10, s
     X = dataset_feature_rows(model, dataset) if dataset_features is None else dataset_features
     hits = []
     for v in values:
-        res = generate(model, n, seed=seed, condition={column: v} if conditioned else None, dataset=dataset,
-                       dataset_features=X)
+        res = nearest_training_meshes(model, n, dataset, seed=seed, condition={column: v} if conditioned else None,
+                                      dataset_features=X)
         hits.append(float(np.mean(res.nearest_labels[column] == v)))
     return np.asarray(hits)

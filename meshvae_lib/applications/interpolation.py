@@ -2,9 +2,9 @@
 
 Three ways to go from mesh A to mesh B in ``n_steps`` steps:
 
-- **latent** (the paper's): encode both with the encoder means, step linearly between the two
-  latent vectors, decode every step (``interpolate_latent``; ``interpolate_generated`` starts from
-  two latent vectors, e.g. two generated shapes);
+- **latent** (the paper's): the straight path between two latent codes (the codes of two meshes,
+  ``model.encode_meshes``, or two generated shapes), decoded (:class:`LatentPath`: every step with
+  ``path.steps(n_steps)``, any point with ``path(t)``);
 - **RIMD**: step linearly between the two RIMD feature vectors and reconstruct every step
   (``interpolate_features``; the paper's first row of Fig. 4, which shows self-intersections);
 - **coordinates**: step linearly between the vertex positions (``interpolate_coordinates``; B is
@@ -34,9 +34,7 @@ __all__ = [
     "linear_steps",
     "interpolate_coordinates",
     "interpolate_features",
-    "interpolate_latent",
     "LatentPath",
-    "interpolate_generated",
     "edge_length_distortion",
     "implausibility",
     "ImplausibilityTable",
@@ -120,51 +118,16 @@ def _to_numpy(x) -> np.ndarray:
     return np.asarray(x, dtype=np.float64)
 
 
-def interpolate_latent(
-    encode: Callable, decode: Callable, x_a, x_b, n_steps: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Interpolation in the latent space with the encoder means (paper Sec. 5.3).
-
-    Parameters
-    ----------
-    encode : callable
-        Inputs of two meshes stacked on a first axis of length 2 -> encoder means ``(2, latent)``
-        (a ``(mu, sigma)`` tuple is accepted).
-    decode : callable
-        ``(n_steps, latent) -> (n_steps, n_vertices, 3)`` meshes.
-    x_a, x_b : whatever ``encode`` takes for one mesh (e.g. ``(n_vertices, 3)`` or ``(K,)``).
-
-    Returns
-    -------
-    z : (n_steps, latent) float64, the latent path
-    V : (n_steps, n_vertices, 3) float64, the decoded meshes
-    """
-    mu = _to_numpy(encode(np.stack([np.asarray(x_a), np.asarray(x_b)])))
-    if mu.ndim != 2 or mu.shape[0] != 2:
-        raise ValueError(f"encode must return (2, latent_dim) for two inputs, got {mu.shape}")
-    return interpolate_generated(decode, mu[0], mu[1], n_steps)
-
-
-def interpolate_generated(decode: Callable, z_a, z_b, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """Interpolation between two latent vectors (e.g. two generated shapes, paper Fig. 6a).
-
-    Returns
-    -------
-    z : (n_steps, latent) float64
-    V : (n_steps, n_vertices, 3) float64
-    """
-    z = linear_steps(z_a, z_b, n_steps)
-    if z.ndim != 2:
-        raise ValueError(f"z_a and z_b must be (latent_dim,) vectors, got {np.shape(z_a)}")
-    return z, _to_numpy(decode(z))
-
-
 class LatentPath:
-    """The straight latent path between two codes, decoded on demand: ``path(t)`` is the mesh at
-    ``z(t) = (1 - t) z_a + t z_b`` (for a slider, e.g. ``InterpolationSlider(..., interpolate=path)``).
+    """Interpolation in the latent space (paper Sec. 4.5, 5.3, Fig. 6a): the straight path between
+    two codes, decoded. ``path(t)`` is the mesh at ``z(t) = (1 - t) z_a + t z_b`` (for a slider,
+    e.g. ``InterpolationSlider(..., interpolate=path)``); ``path.steps(n)`` decodes n evenly spaced
+    steps, both ends included.
 
-    decode : callable ``(latent,) -> (n_vertices, 3)`` (e.g. ``MeshVAEModel.decode_latent``);
-    z_a, z_b : (latent,) float, the two ends (t = 0 and t = 1).
+    decode : callable ``(latent,) -> (n_vertices, 3)`` and ``(n, latent) -> (n, n_vertices, 3)``
+        (e.g. ``MeshVAEModel.decode_latent``);
+    z_a, z_b : (latent,) float, the two ends (t = 0 and t = 1): e.g. the two rows of
+        ``model.encode_meshes(np.stack([V_a, V_b]))``, or two prior draws.
     """
 
     def __init__(self, decode: Callable, z_a, z_b):
@@ -182,6 +145,17 @@ class LatentPath:
     def __call__(self, t: float) -> np.ndarray:
         """The decoded mesh at t, (n_vertices, 3)."""
         return _to_numpy(self.decode(self.latent(t)))
+
+    def steps(self, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
+        """``n_steps`` evenly spaced points of the path, decoded in one call.
+
+        Returns
+        -------
+        z : (n_steps, latent) float64, ``z[0] == z_a``, ``z[-1] == z_b``
+        V : (n_steps, n_vertices, 3) float64
+        """
+        z = linear_steps(self.z_a, self.z_b, n_steps)
+        return z, _to_numpy(self.decode(z))
 
 
 # --------------------------------------------------------------------------------------------

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from meshvae_lib.defaults import INFERENCE_METHODS
+from meshvae_lib.model.inference import INFERENCE_METHODS
 
 from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, result
 
@@ -58,7 +58,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.meshvae_model import load_model
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.collection_io import read_collection
 

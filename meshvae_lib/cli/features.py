@@ -6,7 +6,7 @@ import argparse
 import logging
 from pathlib import Path
 
-from meshvae_lib.defaults import LAYOUTS
+from meshvae_lib.defaults import DEFAULT_LAYOUT, LAYOUTS
 from . import UsageError, add_allow_degenerate, add_command, add_output_argument, resolve_mesh, result
 
 logger = logging.getLogger(__name__)
@@ -37,8 +37,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="reference mesh: an index into the collection (default 0, the first mesh; "
                    "negative counts from the end), a mesh name from the collection, or a mesh file "
                    "with the same connectivity")
-    p.add_argument("--layout", choices=LAYOUTS, default="paper",
-                   help="feature layout (default: paper)")
+    p.add_argument("--layout", choices=LAYOUTS, default=DEFAULT_LAYOUT,
+                   help=f"feature layout (default: {DEFAULT_LAYOUT})")
     add_allow_degenerate(p)
     return p
 

@@ -39,7 +39,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import numpy as np
 
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.meshvae_model import load_model
     from meshvae_lib.geometry.collection_io import write_collection
 
     check_at_least(args.n, 1, "-n")

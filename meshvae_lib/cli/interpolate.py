@@ -35,8 +35,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import numpy as np
 
-    from meshvae_lib.applications.interpolation import interpolate_latent, linear_steps
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.applications.interpolation import LatentPath, linear_steps
+    from meshvae_lib.model.meshvae_model import load_model
     from meshvae_lib.geometry.collection_io import read_collection, write_collection
 
     check_at_least(args.steps, 2, "--steps", "both ends are included")
@@ -55,13 +55,9 @@ def run(args) -> int:
                   for e in ends]  # (1, C) each
         c_path = linear_steps(c_ends[0][0], c_ends[1][0], args.steps).astype(np.float32)
 
-    def encode(V):
-        return model.encode_meshes(V, conditions=None if c_ends is None else np.vstack(c_ends))
-
-    def decode(Z):
-        return model.decode_latent(Z, conditions=c_path)
-
-    _, V = interpolate_latent(encode, decode, ends[0].vertices, ends[1].vertices, args.steps)
+    z = model.encode_meshes(np.stack([np.asarray(e.vertices) for e in ends]),
+                            conditions=None if c_ends is None else np.vstack(c_ends))
+    _, V = LatentPath(lambda Z: model.decode_latent(Z, conditions=c_path), z[0], z[1]).steps(args.steps)
     names = [f"step_{i:03d}" for i in range(args.steps)]
     out = write_collection(args.output, V, model.faces, names=names)
     result(f"wrote {args.steps} meshes from {ends[0].name} to {ends[1].name} to {out}")

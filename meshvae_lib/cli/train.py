@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import logging
 
-from meshvae_lib.defaults import DEFAULT_INIT, FEATURE_KINDS, INIT_MODES, PRIOR_FORMS
+from meshvae_lib.defaults import DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
+from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
                note, result)
 
@@ -46,9 +47,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
     add_output_argument(p, "MODEL.pt", "checkpoint file to write")
-    p.add_argument("--features", choices=FEATURE_KINDS, default="rimd",
+    p.add_argument("--features", choices=FEATURE_KINDS, default=DEFAULT_FEATURE_KIND,
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
-                   " rigidly aligned or raw vertex coordinates (default: rimd)")
+                   f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND})")
     p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
                    help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS})")
@@ -100,7 +101,7 @@ def run(args) -> int:
                          prior_form=args.prior_form, seed=args.seed, init=args.init,
                          early_stopping=False if args.no_early_stopping else None,
                          device=args.device, progress=not args.no_progress)
-    at_most = "at most " if config.resolved_early_stopping(config.uses_pca_init(len(args.labels))) else ""
+    at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
     note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
          f" latent {args.latent}, hidden {list(hidden)}, {at_most}{epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
@@ -115,7 +116,7 @@ def run(args) -> int:
         result(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
                f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
     result(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
-           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.network_.n_features}")
+           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.n_features}")
     if model.holdout_mask_.any():
         res = evaluate_model(model, collection, held_out_only=True, progress=not args.no_progress)
         result(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"

@@ -60,6 +60,22 @@ def _modules(lib: Path, folder: str) -> list[Path]:
     return sorted(p for p in root.glob("*.py") if p.name not in ("__init__.py", "__main__.py"))
 
 
+def _packages(lib: Path, folder: str) -> list[Path]:
+    """The sub-packages of a layer's folder (registries with one module per entry)."""
+    if not folder:
+        return []
+    return sorted(p for p in (lib / folder).iterdir() if (p / "__init__.py").is_file())
+
+
+def _table_modules(lib: Path, folder: str) -> list[Path]:
+    """The modules a layer's table lists: its own, then each sub-package's ``__init__`` (its
+    registry) and modules."""
+    out = list(_modules(lib, folder))
+    for pkg in _packages(lib, folder):
+        out += [pkg / "__init__.py"] + _modules(lib, f"{folder}/{pkg.name}")
+    return out
+
+
 def architecture_markdown(lib: Path | None = None) -> str:
     """The generated Markdown: a tree of the library's folders and modules, then one table per
     folder (module, what it holds, public names)."""
@@ -70,6 +86,10 @@ def architecture_markdown(lib: Path | None = None) -> str:
         if folder:
             tree.append(f"├── {folder}/{'':<{14 - len(folder)}}# {what}")
             tree += [f"│   ├── {p.name}" for p in mods]
+            for pkg in _packages(lib, folder):
+                summary = module_summary(pkg / "__init__.py")[0].split(":")[0]
+                tree.append(f"│   ├── {pkg.name}/{'':<{16 - len(pkg.name)}}# {summary}, a registry")
+                tree += [f"│   │   ├── {p.name}" for p in _modules(lib, f"{folder}/{pkg.name}")]
         else:
             tree += [f"├── {p.name}{'':<{20 - len(p.name)}}# {what}" if i == 0 else f"├── {p.name}"
                      for i, p in enumerate(mods)]
@@ -77,9 +97,10 @@ def architecture_markdown(lib: Path | None = None) -> str:
     tables = []
     for folder, what in LAYER_ORDER:
         rows = ["| module | what it holds | public names |", "| --- | --- | --- |"]
-        for p in _modules(lib, folder):
+        for p in _table_modules(lib, folder):
             summary, names = module_summary(p)
-            dotted = ".".join(x for x in ("meshvae_lib", folder, p.stem) if x)
+            parts = p.relative_to(lib).with_suffix("").parts
+            dotted = ".".join(("meshvae_lib",) + (parts[:-1] if parts[-1] == "__init__" else parts))
             listed = ", ".join(f"`{n}`" for n in names) or "(none)"
             summary = summary.replace("|", "\\|")
             rows.append(f"| `{dotted}` | {summary} | {listed} |")

@@ -9,10 +9,11 @@ cache and returned.
 The cache lives in ``$MESHVAE_CACHE`` when set, else ``$XDG_CACHE_HOME/meshvae``, else
 ``~/.cache/meshvae`` (:func:`cache_dir`). An entry's file name holds its key (:func:`model_key`): a
 hash of everything that determines the model -- the specification, the full training
-configuration, the numpy and torch versions and the code of the library layers that make the data
-and train the model (its syntax trees: editing a comment or a docstring keeps the cache). A change
-to any of them gives another key, so a stale entry is never loaded; it is removed when the new one
-is written. A damaged entry (a failed checksum, a truncated
+configuration, the numpy and torch versions and the code that makes the data and trains the model:
+the import closure of :data:`TRAINING_ENTRY_POINTS` (:mod:`~meshvae_lib.course.closure`; its syntax
+trees: editing a comment or a docstring, or a module training never imports, keeps the cache). A
+change to any of them gives another key, so a stale entry is never loaded; it is removed when the
+new one is written. A damaged entry (a failed checksum, a truncated
 file) is logged, removed and rebuilt. Checkpoints are written atomically (``model.save``), so an
 interrupted build leaves no half-written entry.
 """
@@ -27,21 +28,22 @@ import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
-from meshvae_lib.applications.embedding import embedding_sigma_object
-from meshvae_lib.applications.exploration import exploration_sigma_object
-from meshvae_lib.defaults import CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, EMBEDDING_ALPHA, EMBEDDING_HIDDEN, EMBEDDING_SEEDS
+from meshvae_lib.course.closure import closure_fingerprint
+from meshvae_lib.defaults import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, DEFAULT_FEATURE_KIND, EMBEDDING_ALPHA,
+                                  EMBEDDING_HIDDEN, EMBEDDING_SEEDS, EMBEDDING_SIGMA_OBJECT, EXPLORATION_SIGMA_OBJECT)
+from meshvae_lib.model.train_config import pad_sigma_object
 
 logger = logging.getLogger(__name__)
 
 #: environment variable that overrides the cache folder.
 CACHE_ENV = "MESHVAE_CACHE"
 
-#: the parts of meshvae_lib whose source does not determine a trained model: the applications, the
-#: evaluation and the latent inference with the reconstruction's linearisation (they use a model,
-#: not train it), the paper's experiments (their own models), the viewers, the command line and
-#: this course layer. Everything else, and all of data_synth, is in the key.
-_CODE_EXCLUDED = ("applications", "paper", "viewing", "cli", "course", "model/evaluation.py", "model/inference.py",
-                  "geometry/reconstruction_linearization.py")
+#: where a course model's making starts: the estimator that trains it and the builder of its data.
+#: Their import closure is the code in the key (:func:`code_fingerprint`).
+TRAINING_ENTRY_POINTS = ("meshvae_lib.model.meshvae_model", "data_synth.registry")
+#: packages in that closure that do not change a trained model: the latent inference strategies
+#: (they use a model, not train it; training only checks the inference's name).
+NOT_TRAINING = ("meshvae_lib.model.inference",)
 
 
 @dataclass(frozen=True)
@@ -63,7 +65,7 @@ class CourseModelSpec:
     description: str
     minutes: float
     data_seed: int = 0
-    features: str = "rimd"
+    features: str = DEFAULT_FEATURE_KIND
     labels: tuple[str, ...] = ()
     layout: str = "compact"
     holdout_every: int = 5
@@ -104,7 +106,7 @@ _EMBEDDING_BODIES = replace(
                 "latent 128, 153 epochs (918 Adam steps: 6 batches of 35 meshes)",
     minutes=0.5,
     config={"epochs": 153, "latent_dim": 128, "batch_size": 32, "alpha": EMBEDDING_ALPHA, "hidden": EMBEDDING_HIDDEN,
-            "sigma_object": tuple(float(s) for s in embedding_sigma_object(128)), "prior_form": "sibling", "seed": 0},
+            "sigma_object": tuple(float(s) for s in pad_sigma_object(EMBEDDING_SIGMA_OBJECT, 128)), "prior_form": "sibling", "seed": 0},
 )
 _EMBEDDING_ABLATIONS = (
     replace(_EMBEDDING_BODIES, name="embedding-bodies-exact-kl",
@@ -149,7 +151,7 @@ COURSE_MODELS: dict[str, CourseModelSpec] = {
             minutes=2.0,
             holdout_every=0,
             config={"epochs": 1000, "latent_dim": 16, "batch_size": 16, "alpha": EMBEDDING_ALPHA,
-                    "hidden": EMBEDDING_HIDDEN, "sigma_object": tuple(float(s) for s in exploration_sigma_object(16)),
+                    "hidden": EMBEDDING_HIDDEN, "sigma_object": tuple(float(s) for s in pad_sigma_object(EXPLORATION_SIGMA_OBJECT, 16)),
                     "prior_form": "sibling", "seed": 0},
         ),
     )
@@ -164,39 +166,20 @@ def cache_dir() -> Path:
     return Path(base).expanduser() / "meshvae"
 
 
-def code_fingerprint() -> str:
-    """sha256 of the code of ``data_synth`` and of the ``meshvae_lib`` modules that make a trained
-    model (not ``_CODE_EXCLUDED``): their relative paths and syntax trees, docstrings left out, in
-    sorted order. Comments and docstrings do not change a trained model, so editing them keeps the
-    cache; any change to the code itself (or a new Python whose syntax trees print differently)
-    rebuilds it."""
-    import data_synth
-    import meshvae_lib
+def code_fingerprint(roots: dict | None = None) -> str:
+    """sha256 of the code that makes a course model: the import closure of
+    :data:`TRAINING_ENTRY_POINTS` in ``meshvae_lib`` and ``data_synth`` (``roots``: package name ->
+    folder, default the installed ones), its module names and syntax trees without docstrings
+    (:func:`~meshvae_lib.course.closure.closure_fingerprint`). Comments, docstrings and modules
+    that training does not import do not change a trained model, so editing them keeps the cache;
+    any change to the code itself (or a new Python whose syntax trees print differently) rebuilds
+    it."""
+    if roots is None:
+        import data_synth
+        import meshvae_lib
 
-    h = hashlib.sha256()
-    for package in (meshvae_lib, data_synth):
-        root = Path(package.__file__).parent
-        for path in sorted(root.rglob("*.py")):
-            rel = path.relative_to(root)
-            if rel.parts[0] in _CODE_EXCLUDED or rel.as_posix() in _CODE_EXCLUDED:
-                continue
-            h.update(f"{package.__name__}/{rel.as_posix()}\0".encode())
-            h.update(_code_without_docstrings(path.read_text()).encode())
-    return h.hexdigest()
-
-
-def _code_without_docstrings(source: str) -> str:
-    """``ast.dump`` of ``source`` with every module, class and function docstring removed."""
-    import ast
-
-    tree = ast.parse(source)
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
-                    and isinstance(body[0].value.value, str):
-                node.body = body[1:] or [ast.Pass()]
-    return ast.dump(tree)
+        roots = {p.__name__: Path(p.__file__).parent for p in (meshvae_lib, data_synth)}
+    return closure_fingerprint(TRAINING_ENTRY_POINTS, roots, exclude=NOT_TRAINING)
 
 
 def model_key(spec: CourseModelSpec) -> str:
@@ -250,7 +233,7 @@ def course_model(name: str, progress: bool = True, rebuild: bool = False):
     written to the cache atomically, and returned. ``rebuild``: train even when cached. Older
     entries of the same model (other keys) are removed when a new one is written.
     """
-    from meshvae_lib.model.checkpoint import load_model
+    from meshvae_lib.model.meshvae_model import load_model
 
     spec = get_spec(name)
     key = model_key(spec)

@@ -26,12 +26,16 @@ class MeshCollection:
     faces : (n_faces, 3) int64
     names : list of str, length n_meshes
     labels : dict str -> (n_meshes,) array (numbers or str)
+    description : str, one line (what the collection is)
+    extras : dict, anything else that came with the meshes (e.g. a generator's ``rest`` template)
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     names: list[str] = field(default_factory=list)
     labels: dict[str, np.ndarray] = field(default_factory=dict)
+    description: str = ""
+    extras: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.vertices = check_vertices(self.vertices, batch=True)
@@ -72,7 +76,7 @@ class MeshCollection:
         if idx.min() < -len(self) or idx.max() >= len(self):
             raise ValueError(f"indices must lie in [0, {len(self) - 1}], got range [{idx.min()}, {idx.max()}]")
         return MeshCollection(self.vertices[idx], self.faces, [self.names[i] for i in idx],
-                              {k: v[idx] for k, v in self.labels.items()})
+                              {k: v[idx] for k, v in self.labels.items()}, self.description, dict(self.extras))
 
 
 def default_names(n: int) -> list[str]:

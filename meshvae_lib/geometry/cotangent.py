@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib import tolerances as tol
-from meshvae_lib.geometry.topology import face_edge_indices, edges
-from meshvae_lib.validation import check_mesh
+from meshvae_lib.geometry.topology import MeshTopology
+from meshvae_lib.validation import check_mesh, check_vertices
 
 __all__ = ["corner_cotangents", "cotangent_weights"]
 
@@ -44,6 +44,10 @@ def corner_cotangents(V, F) -> np.ndarray:
         NaN for a zero-area face.
     """
     V, F = check_mesh(V, F, batch=False, name="V")
+    return _corner_cotangents(V, F)
+
+
+def _corner_cotangents(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     P = V[F]  # (m, 3, 3)
     a = np.roll(P, -1, axis=1) - P  # corner k -> k+1
     b = np.roll(P, -2, axis=1) - P  # corner k -> k+2
@@ -53,7 +57,7 @@ def corner_cotangents(V, F) -> np.ndarray:
         return dot / cross
 
 
-def cotangent_weights(V, F, clamp: bool = True) -> np.ndarray:
+def cotangent_weights(V, F, clamp: bool = True, topology: MeshTopology | None = None) -> np.ndarray:
     """Cotangent weights ``c_ij = cot alpha_ij + cot beta_ij`` of every edge (paper Eq. 1).
 
     Parameters
@@ -70,11 +74,17 @@ def cotangent_weights(V, F, clamp: bool = True) -> np.ndarray:
     -------
     c : (n_edges,) float64
         Aligned with :func:`meshvae_lib.geometry.topology.edges`. Boundary edges have one term only.
+    topology : MeshTopology of ``F``, optional
+        Precomputed (then ``F`` is not checked again).
     """
-    V, F = check_mesh(V, F, batch=False, name="V")
-    cot = corner_cotangents(V, F)
-    FE = face_edge_indices(F)  # edge opposite each corner
-    c = np.bincount(FE.reshape(-1), weights=cot.reshape(-1), minlength=len(edges(F)))
+    if topology is None:
+        V, F = check_mesh(V, F, batch=False, name="V")
+        topology = MeshTopology(F, len(V))
+    else:
+        V = check_vertices(V, "V", batch=False, n_vertices=topology.n_vertices)
+    cot = _corner_cotangents(V, topology.faces)
+    FE = topology.face_edges  # edge opposite each corner
+    c = np.bincount(FE.reshape(-1), weights=cot.reshape(-1), minlength=len(topology.edges))
     # bincount turns inf into nan when +inf and -inf meet; keep inf where it arose
     if clamp:
         c = np.where(np.isnan(c) | (c > tol.COT_WEIGHT_MAX), tol.COT_WEIGHT_FALLBACK, c)

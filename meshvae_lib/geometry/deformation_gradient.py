@@ -35,9 +35,8 @@ from meshvae_lib import defaults as hp
 from meshvae_lib import tolerances as tol
 from meshvae_lib.geometry.cotangent import cotangent_weights
 from meshvae_lib.geometry.rotations import from_soa
-from meshvae_lib.geometry.topology import (
-    directed_edges, edge_index, edges, vertex_face_incidence, vertex_normal_sums)
-from meshvae_lib.validation import check_mesh, check_vertices
+from meshvae_lib.geometry.topology import MeshTopology, edge_index, vertex_normal_sums
+from meshvae_lib.validation import check_vertices
 
 __all__ = ["DeformationGradientOperator", "deformation_gradients"]
 
@@ -61,6 +60,9 @@ class DeformationGradientOperator:
 
     Attributes
     ----------
+    topology : MeshTopology
+        The reference mesh's connectivity, checked and computed once (passed on to whatever else
+        is built for this mesh: the RIMD layout, the reconstructor).
     n_vertices : int
     faces : (n_faces, 3) int64
     edges : (n_edges, 2) int64
@@ -83,23 +85,25 @@ class DeformationGradientOperator:
     """
 
     def __init__(self, V0, F, normal_term: bool = True, clamp: bool = True):
-        V0, F = check_mesh(V0, F, batch=False, name="V0")
+        V0 = check_vertices(V0, "V0", batch=False)
         n = V0.shape[0]
+        self.topology = topo = MeshTopology(F, n)  # the faces checked (indices below n) once
+        F = topo.faces
         self.n_vertices = n
-        self.faces = F
-        self.edges = edges(F)
-        D = directed_edges(F)
+        self.faces = topo.faces
+        self.edges = topo.edges
+        D = topo.directed
         self.directed = D
         counts = np.bincount(D[:, 0], minlength=n)
         if np.any(counts == 0):
             k = int(np.flatnonzero(counts == 0)[0])
             raise ValueError(f"vertex {k} belongs to no face (unreferenced vertices are not allowed)")
-        self.weights = cotangent_weights(V0, F, clamp=clamp)
+        self.weights = cotangent_weights(V0, F, clamp=clamp, topology=topo)
         c = self.weights[edge_index(self.edges, D[:, 0], D[:, 1])]  # (2E,)
         e = V0[D[:, 0]] - V0[D[:, 1]]  # e_ij = p_i - p_j, (2E, 3)
         lengths = np.linalg.norm(V0[self.edges[:, 0]] - V0[self.edges[:, 1]], axis=1)
         self.normal_length = float(hp.NORMAL_EDGE_SCALE * lengths.mean())
-        self._normal_sums = vertex_normal_sums(V0, F)
+        self._normal_sums = vertex_normal_sums(V0, F, topology=topo)
         ns = np.linalg.norm(self._normal_sums, axis=1)
         if np.any(ns <= 0):
             k = int(np.flatnonzero(ns <= 0)[0])
@@ -181,8 +185,6 @@ class DeformationGradientOperator:
 
     def _normal_sums_batch(self, V: np.ndarray) -> np.ndarray:
         """:func:`vertex_normal_sums` of ``(N, n, 3)`` with the incidence matrix built once."""
-        if not hasattr(self, "_incidence"):
-            self._incidence = vertex_face_incidence(self.faces, self.n_vertices)
         F = self.faces
         p0 = V[:, F[:, 0], :]
         a = V[:, F[:, 1], :] - p0
@@ -192,7 +194,7 @@ class DeformationGradientOperator:
         c[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
         c[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
         N, m = V.shape[0], len(F)
-        acc = self._incidence @ c.transpose(1, 0, 2).reshape(m, N * 3)
+        acc = self.topology.incidence @ c.transpose(1, 0, 2).reshape(m, N * 3)
         return np.asarray(acc).reshape(self.n_vertices, N, 3).transpose(1, 0, 2)
 
     def deformed_normal_edges(self, V) -> np.ndarray:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from meshvae_lib.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+from meshvae_lib.defaults import DEFAULT_LAYOUT, RECONSTRUCTION_METHODS, ROTATION_RECOVERY
 from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
 from meshvae_lib.geometry.position_solvers import ExactPositionSolver, PaperPositionSolver
@@ -66,6 +66,8 @@ class RIMDReconstructor:
         mesh (a twist of the reference about its main axis) and refines only if not; ``True``
         always checks and refines, ``False`` never. Without them, meshes with perfectly symmetric
         one-rings (procedural meshes) keep errors around 1e-5 of the diagonal.
+    operator : DeformationGradientOperator of ``(V0, F)``, optional
+        Built already (e.g. by a :class:`~meshvae_lib.geometry.rimd.RIMDEncoder` of the same mesh).
 
     Attributes
     ----------
@@ -77,18 +79,19 @@ class RIMDReconstructor:
         ``method="exact"``: whether Gauss-Newton steps are taken (see ``refine``).
     """
 
-    def __init__(self, V0, F, method: str = "exact", layout: str = "paper",
-                 rotations: str = "global", iterations: int | None = None, refine="auto"):
+    def __init__(self, V0, F, method: str = "exact", layout: str = DEFAULT_LAYOUT,
+                 rotations: str = "global", iterations: int | None = None, refine="auto",
+                 operator: DeformationGradientOperator | None = None):
         self.method = check_choice(method, RECONSTRUCTION_METHODS, "method")
         self.rotations = check_choice(rotations, ROTATION_RECOVERY, "rotations")
         self.iterations = 0 if iterations is None else check_count(iterations, "iterations")
         self.refine = check_choice(refine, ("auto", True, False), "refine")
-        op = DeformationGradientOperator(V0, F)
+        op = DeformationGradientOperator(V0, F) if operator is None else operator
         self.operator = op
         self.V0 = np.asarray(V0, dtype=np.float64)
         self.faces = op.faces
         self.n_vertices = op.n_vertices
-        self.layout = RIMDLayout(op.faces, op.n_vertices, layout)
+        self.layout = RIMDLayout(op.faces, op.n_vertices, layout, topology=op.topology)
         self._rotation_recovery = RotationRecovery(self.layout.edges, op.n_vertices, rotations)
         self.roots = self._rotation_recovery.roots
         if method == "exact":

@@ -32,13 +32,13 @@ import logging
 
 import numpy as np
 
-from meshvae_lib.defaults import LAYOUTS
+from meshvae_lib.defaults import DEFAULT_LAYOUT, LAYOUTS
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
 from meshvae_lib.geometry.polar import polar_rs_soa
 from meshvae_lib.geometry.rotations import quat_from_soa, relative_log_quat
-from meshvae_lib.geometry.topology import directed_edges, edge_index, edges
+from meshvae_lib.geometry.topology import MeshTopology, edge_index
 from meshvae_lib.progress import progress as progress_bar
-from meshvae_lib.validation import check_choice, check_faces, check_rows
+from meshvae_lib.validation import check_choice, check_rows
 
 __all__ = ["S_ENTRIES", "RIMDLayout", "RIMDEncoder", "rimd_features"]
 
@@ -57,6 +57,8 @@ class RIMDLayout:
     F : (n_faces, 3) int
     n_vertices : int
     layout : {"paper", "compact"}
+    topology : MeshTopology of ``F``, optional
+        Precomputed (then ``F`` is not checked again).
 
     Attributes
     ----------
@@ -73,16 +75,17 @@ class RIMDLayout:
         The rotation block (``3 * n_rotation_edges`` numbers) and the S block (``6 * n_vertices``).
     """
 
-    def __init__(self, F, n_vertices: int, layout: str = "paper"):
+    def __init__(self, F, n_vertices: int, layout: str = DEFAULT_LAYOUT, topology: MeshTopology | None = None):
         check_choice(layout, LAYOUTS, "layout")
         n_vertices = int(n_vertices)
-        F = check_faces(F, n_vertices=n_vertices)
+        if topology is None or topology.n_vertices != n_vertices:
+            topology = MeshTopology(F, n_vertices)
         self.layout = layout
         self.n_vertices = n_vertices
-        self.edges = edges(F)
+        self.edges = topology.edges
         self.n_edges = len(self.edges)
         if layout == "paper":
-            D = directed_edges(F)
+            D = topology.directed
             self.rotation_edges = D
             self._undirected = edge_index(self.edges, D[:, 0], D[:, 1])
             self._sign = np.where(D[:, 0] < D[:, 1], 1.0, -1.0)
@@ -274,6 +277,9 @@ class RIMDEncoder:
         Reference mesh.
     F : (n_faces, 3) int
     layout : {"paper", "compact"}
+    operator : DeformationGradientOperator of ``(V0, F)``, optional
+        Built already (e.g. for a :class:`~meshvae_lib.geometry.reconstruction.RIMDReconstructor`
+        of the same mesh); then ``V0`` and ``F`` are its own.
 
     Attributes
     ----------
@@ -281,9 +287,9 @@ class RIMDEncoder:
     operator : DeformationGradientOperator
     """
 
-    def __init__(self, V0, F, layout: str = "paper"):
-        self.operator = DeformationGradientOperator(V0, F)
-        self.layout = RIMDLayout(self.operator.faces, self.operator.n_vertices, layout)
+    def __init__(self, V0, F, layout: str = DEFAULT_LAYOUT, operator: DeformationGradientOperator | None = None):
+        self.operator = DeformationGradientOperator(V0, F) if operator is None else operator
+        self.layout = RIMDLayout(self.operator.faces, self.operator.n_vertices, layout, topology=self.operator.topology)
         self.V0 = np.asarray(V0, dtype=np.float64)
         self.faces = self.operator.faces
 
@@ -339,12 +345,11 @@ class RIMDEncoder:
         S6 = np.ascontiguousarray(s[_S_FLAT].T).reshape(N, n, 6)
         return self.layout.pack(log_dR, S6)
 
-    def __call__(self, V) -> np.ndarray:
-        return self.transform(V)
 
-
-def rimd_features(V0, V, F, layout: str = "paper") -> np.ndarray:
-    """RIMD feature(s) of deformed mesh(es) relative to the reference ``V0`` (paper Eq. 2).
+def rimd_features(V0, V, F, layout: str = DEFAULT_LAYOUT) -> np.ndarray:
+    """RIMD feature(s) of deformed mesh(es) relative to the reference ``V0`` (paper Eq. 2): a
+    one-off ``RIMDEncoder(V0, F, layout).transform(V)`` (build the encoder once to encode more meshes
+    against the same reference).
 
     Parameters
     ----------

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from meshvae_lib.defaults import DEFAULT_LAYOUT
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.validation import check_rows
 
@@ -25,7 +26,7 @@ FEATURE_FILE_KEYS = ("features", "reference", "faces", "names", "layout")
 
 
 def save_features(path, features, reference, faces, names=None, labels=None,
-                  layout: str = "paper") -> None:
+                  layout: str = DEFAULT_LAYOUT) -> None:
     """Write a feature file (``.npz``, uncompressed, float64 kept).
 
     Parameters
@@ -94,7 +95,7 @@ def load_features(path) -> dict:
             "features": np.asarray(data["features"], dtype=np.float64),
             "reference": np.asarray(data["reference"], dtype=np.float64),
             "faces": np.asarray(data["faces"], dtype=np.int64),
-            "layout": str(data["layout"]) if "layout" in data.files else "paper",
+            "layout": str(data["layout"]) if "layout" in data.files else DEFAULT_LAYOUT,
             "labels": {k[len("label_"):]: np.asarray(data[k]) for k in data.files
                        if k.startswith("label_")},
         }

@@ -1,4 +1,5 @@
-"""Connectivity of a triangle mesh: edges, one-rings, boundaries, normals and areas.
+"""Connectivity of a triangle mesh: edges, one-rings, normals and areas (boundaries:
+:mod:`~meshvae_lib.geometry.boundaries`).
 
 Everything here depends only on the faces ``F`` (and, for normals, areas and edge lengths, on
 positions ``V``).
@@ -7,8 +8,9 @@ Edge order is fixed once and for all: :func:`edges` returns the undirected edges
 sorted by source vertex then target vertex, which is exactly the concatenation of the one-rings
 (:func:`one_rings`). Cotangent weights and the RIMD feature layout follow these orders.
 
-All functions are vectorised (no Python loop over vertices, edges or faces) except
-:func:`boundary_loops`, whose loop runs over boundary edges only.
+All functions are vectorised (no Python loop over vertices, edges or faces). :class:`MeshTopology`
+holds the connectivity of one mesh, checked and computed once, for the classes that precompute
+things for a reference mesh.
 """
 
 from __future__ import annotations
@@ -16,17 +18,15 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from meshvae_lib.validation import check_faces, check_mesh
+from meshvae_lib.validation import check_faces, check_mesh, check_vertices
 
 __all__ = [
+    "MeshTopology",
     "edges",
     "directed_edges",
     "face_edge_indices",
     "edge_index",
     "one_rings",
-    "boundary_edges",
-    "boundary_vertices",
-    "boundary_loops",
     "face_normals",
     "vertex_normals",
     "vertex_normal_sums",
@@ -34,6 +34,53 @@ __all__ = [
     "face_areas",
     "edge_lengths",
 ]
+
+
+class MeshTopology:
+    """The connectivity of one triangle mesh, checked once and computed once.
+
+    The classes that precompute things for one reference mesh (the deformation-gradient operator,
+    the RIMD layout, the reconstructor) build one and pass it along instead of checking the faces
+    and computing the edge list again and again.
+
+    Parameters
+    ----------
+    F : (n_faces, 3) int
+    n_vertices : int
+        Every face index must be below it.
+
+    Attributes
+    ----------
+    faces : (n_faces, 3) int64, checked
+    n_vertices : int
+    edges : (n_edges, 2) int64, as :func:`edges`
+    directed : (2 n_edges, 2) int64, as :func:`directed_edges`
+    face_edges : (n_faces, 3) int64, as :func:`face_edge_indices`
+    incidence : (n_vertices, n_faces) csr_matrix, as :func:`vertex_face_incidence`
+    """
+
+    def __init__(self, F, n_vertices: int):
+        self.faces = check_faces(F, n_vertices=int(n_vertices))
+        self.n_vertices = int(n_vertices)
+        self.edges = _edges(self.faces)
+        self.directed = _directed(self.edges)
+        self._face_edges = None
+        self._incidence = None
+
+    @property
+    def face_edges(self) -> np.ndarray:
+        if self._face_edges is None:
+            self._face_edges = _face_edge_indices(self.faces, self.edges)
+        return self._face_edges
+
+    @property
+    def incidence(self) -> sp.csr_matrix:
+        if self._incidence is None:
+            self._incidence = _incidence(self.faces, self.n_vertices)
+        return self._incidence
+
+    def __repr__(self) -> str:
+        return f"MeshTopology(n_vertices={self.n_vertices}, n_faces={len(self.faces)}, n_edges={len(self.edges)})"
 
 
 def _face_half_edges(F: np.ndarray) -> np.ndarray:
@@ -57,7 +104,10 @@ def edges(F) -> np.ndarray:
     E : (n_edges, 2) int64
         Each edge once as ``(i, j)`` with ``i < j``, sorted lexicographically.
     """
-    F = check_faces(F)
+    return _edges(check_faces(F))
+
+
+def _edges(F: np.ndarray) -> np.ndarray:
     he = np.sort(_face_half_edges(F), axis=1)
     return np.unique(he, axis=0) if len(he) else np.zeros((0, 2), np.int64)
 
@@ -110,7 +160,10 @@ def face_edge_indices(F) -> np.ndarray:
         ``FE[f, k]`` is the edge joining ``F[f, k+1]`` and ``F[f, k+2]`` (indices mod 3).
     """
     F = check_faces(F)
-    E = edges(F)
+    return _face_edge_indices(F, _edges(F))
+
+
+def _face_edge_indices(F: np.ndarray, E: np.ndarray) -> np.ndarray:
     opp = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1)  # (m, 3, 2)
     return edge_index(E, opp[..., 0], opp[..., 1])
 
@@ -128,7 +181,10 @@ def directed_edges(F) -> np.ndarray:
         Rows ``(i, j)`` sorted by ``i`` then ``j``; the rows with source ``i`` are the one-ring of
         ``i`` (see :func:`one_rings`).
     """
-    E = edges(F)
+    return _directed(edges(F))
+
+
+def _directed(E: np.ndarray) -> np.ndarray:
     D = np.concatenate([E, E[:, ::-1]], axis=0)
     order = np.lexsort((D[:, 1], D[:, 0]))
     return D[order]
@@ -160,84 +216,6 @@ def one_rings(F, n_vertices: int | None = None) -> tuple[np.ndarray, np.ndarray]
     counts = np.bincount(D[:, 0], minlength=n_vertices)
     indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     return indptr, D[:, 1].copy()
-
-
-def boundary_edges(F) -> np.ndarray:
-    """Boundary half-edges, oriented as in their only face.
-
-    Parameters
-    ----------
-    F : (n_faces, 3) int
-
-    Returns
-    -------
-    B : (n_boundary_edges, 2) int64
-        Directed edges ``(i, j)`` that belong to exactly one face, in the direction that face
-        traverses them (so a boundary loop is followed by chaining ``j`` to the next ``i``).
-    """
-    F = check_faces(F)
-    he = _face_half_edges(F)
-    key = np.sort(he, axis=1)
-    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    return he[counts[inv.reshape(-1)] == 1]
-
-
-def boundary_vertices(F) -> np.ndarray:
-    """Vertices on the mesh boundary.
-
-    Parameters
-    ----------
-    F : (n_faces, 3) int
-
-    Returns
-    -------
-    b : (n_boundary_vertices,) int64
-        Sorted ids of vertices incident to an edge that has only one face. Empty for a closed mesh.
-    """
-    return np.unique(boundary_edges(F).reshape(-1))
-
-
-def boundary_loops(F) -> list[np.ndarray]:
-    """Boundary loops as ordered vertex cycles.
-
-    Parameters
-    ----------
-    F : (n_faces, 3) int
-
-    Returns
-    -------
-    loops : list of (loop_length,) int64
-        Each loop lists its vertices in the order the adjacent faces traverse the boundary, starting
-        at its smallest vertex id; loops are sorted by that start vertex. Empty for a closed mesh.
-
-    Raises
-    ------
-    ValueError
-        If a boundary vertex has more than one outgoing boundary edge (non-manifold boundary).
-    """
-    B = boundary_edges(F)
-    if len(B) == 0:
-        return []
-    src, dst = B[:, 0], B[:, 1]
-    if len(np.unique(src)) != len(src):
-        vals, c = np.unique(src, return_counts=True)
-        raise ValueError(f"non-manifold boundary at vertex {vals[c > 1][0]}")
-    nxt = dict(zip(src.tolist(), dst.tolist()))
-    loops = []
-    remaining = set(nxt)
-    while remaining:
-        start = min(remaining)
-        loop = [start]
-        remaining.discard(start)
-        v = nxt[start]
-        while v != start:
-            if v not in remaining:
-                raise ValueError(f"boundary does not close into a loop at vertex {v}")
-            loop.append(v)
-            remaining.discard(v)
-            v = nxt[v]
-        loops.append(np.asarray(loop, dtype=np.int64))
-    return loops
 
 
 def _face_cross(V: np.ndarray, F: np.ndarray) -> np.ndarray:
@@ -303,7 +281,7 @@ def vertex_normals(V, F) -> np.ndarray:
     return _unit_or_zero(vertex_normal_sums(V, F))
 
 
-def vertex_normal_sums(V, F) -> np.ndarray:
+def vertex_normal_sums(V, F, topology: MeshTopology | None = None) -> np.ndarray:
     """Unnormalised area-weighted vertex normals: sum over incident faces of ``2 area_f n_f``.
 
     Parameters
@@ -316,12 +294,18 @@ def vertex_normal_sums(V, F) -> np.ndarray:
     S : (n_vertices, 3) or (n_meshes, n_vertices, 3) float64
         Sum of the face cross products ``(p1 - p0) x (p2 - p0)`` around each vertex; it scales with
         the square of the mesh size.
+    topology : MeshTopology of ``F``, optional
+        Precomputed (then ``F`` is not checked again).
     """
-    V, F = check_mesh(V, F)
+    if topology is None:
+        V, F = check_mesh(V, F)
+        inc = _incidence(F, V.shape[-2])
+    else:
+        V = check_vertices(V, "V", n_vertices=topology.n_vertices)
+        F, inc = topology.faces, topology.incidence
     n = V.shape[-2]
     m = len(F)
     c = _face_cross(V, F)  # (..., m, 3)
-    inc = vertex_face_incidence(F, n)
     if V.ndim == 2:
         return np.asarray(inc @ c)
     N = V.shape[0]
@@ -343,7 +327,10 @@ def vertex_face_incidence(F, n_vertices: int) -> sp.csr_matrix:
         ``I[i, f] = 1`` when vertex ``i`` is a corner of face ``f``; ``I @ x`` sums a per-face
         quantity ``x (n_faces, k)`` around every vertex.
     """
-    F = check_faces(F, n_vertices=n_vertices)
+    return _incidence(check_faces(F, n_vertices=n_vertices), n_vertices)
+
+
+def _incidence(F: np.ndarray, n_vertices: int) -> sp.csr_matrix:
     m = len(F)
     return sp.csr_matrix(
         (np.ones(3 * m), (F.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n_vertices, m)

@@ -1,9 +1,12 @@
-"""The mesh VAE's one-file checkpoint: ``model.save(path)`` writes it, :func:`load_model` reads it.
+"""The mesh VAE's one-file checkpoint format: a model's state <-> one file.
 
-A checkpoint is one file written with ``torch.save`` that holds only tensors, numbers, strings,
-lists and dicts (it loads with ``weights_only=True``: no code runs when reading it), plus a
-checksum of the weights and the reference mesh, so that a corrupted, truncated or foreign file
-gives a clear error instead of a broken model.
+:func:`write_checkpoint` (behind ``model.save(path)``) writes the state a model gives
+(:meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.state_dict`), :func:`read_checkpoint` reads it
+back (``meshvae_model.load_model`` builds the model from it). A checkpoint is one file written with
+``torch.save`` that holds only tensors, numbers, strings, lists and dicts (it loads with
+``weights_only=True``: no code runs when reading it), plus a checksum of the weights and the
+reference mesh, so that a corrupted, truncated or foreign file gives a clear error instead of a
+broken model. Files of formats 1 and 2 are read too (:func:`read_checkpoint` upgrades them).
 """
 
 from __future__ import annotations
@@ -18,21 +21,16 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from meshvae_lib.model.features import ConditionEncoder, FeatureExtractor
-from meshvae_lib.model.meshvae_model import MeshVAEModel
-from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.model.train_config import TrainConfig
-from meshvae_lib.model.vae import MeshVAE
-
-__all__ = ["load_model", "write_checkpoint", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
+__all__ = ["write_checkpoint", "read_checkpoint", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
 
 logger = logging.getLogger(__name__)
 
 #: value of the ``format`` entry of every checkpoint.
 CHECKPOINT_FORMAT = "meshvae-checkpoint"
 #: bumped when the layout of the checkpoint changes (2: the network config has ``sigma_floor`` and ``output``;
-#: version 1 files load with their defaults, 0 and "tanh").
-CHECKPOINT_VERSION = 2
+#: version 1 files load with their defaults, 0 and "tanh"; 3: the network's ``architecture``, the feature
+#: kind's state instead of the feature extractor's, the epochs trained and early stopping's record).
+CHECKPOINT_VERSION = 3
 
 
 def _to_storable(obj):
@@ -49,10 +47,13 @@ def _to_storable(obj):
 
 
 def _to_numpy(obj):
+    """tensors -> numpy arrays, recursively (the inverse of :func:`_to_storable`)."""
     if isinstance(obj, torch.Tensor):
         return obj.numpy()
     if isinstance(obj, dict):
         return {k: _to_numpy(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_to_numpy(v) for v in obj]
     return obj
 
 
@@ -66,38 +67,24 @@ def _checksum(state_dict: dict, reference: np.ndarray, faces: np.ndarray) -> str
     return h.hexdigest()
 
 
-def write_checkpoint(path, model: MeshVAEModel) -> Path:
-    """Write ``model`` to ``path`` as one checkpoint file (what ``model.save(path)`` does). Returns
-    the path.
+def write_checkpoint(path, state: dict) -> Path:
+    """Write a model's ``state`` (:meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.state_dict`) to
+    ``path`` as one checkpoint file (what ``model.save(path)`` does). Returns the path.
 
     The file is written next to its destination and renamed, so an interrupted save never leaves a
     half-written checkpoint under the final name.
     """
-    model._check_fitted()
     path = Path(path)
     if path.parent and not path.parent.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-    state = {k: v.detach().cpu().clone() for k, v in model.network_.state_dict().items()}
-    ext = model.extractor_.state_dict()
+    network_state = state["network_state"]
     payload = {
         "format": CHECKPOINT_FORMAT,
         "version": CHECKPOINT_VERSION,
         "torch_version": str(torch.__version__),
-        "network_config": model.network_.config(),
-        "network_state": state,
-        "normalizer": _to_storable(model.normalizer_.state_dict()),
-        "extractor": _to_storable(ext),
-        "conditions": model.conditions_.state_dict(),
-        "train_conditions": torch.from_numpy(np.ascontiguousarray(model.train_conditions_, dtype=np.float32)),
-        "sigma_object": torch.from_numpy(np.asarray(model.sigma_object_, dtype=np.float64)),
-        "train_config": model.train_config_.to_dict(),
-        "estimator": {"features": model.features, "labels": list(model.labels),
-                      "holdout_every": int(model.holdout_every), "layout": model.layout,
-                      "reference_index": int(model.reference_index), "inference": str(model.inference)},
-        "holdout_mask": torch.from_numpy(np.asarray(model.holdout_mask_, dtype=bool)),
-        "history": [dict(h) for h in getattr(model, "history_", [])],
-        "train_seconds": float(getattr(model, "train_seconds_", 0.0)),
-        "checksum": _checksum(state, ext["reference"], ext["faces"]),
+        **{k: _to_storable(v) for k, v in state.items() if k != "network_state"},
+        "network_state": network_state,
+        "checksum": _checksum(network_state, state["kind"]["reference"], state["kind"]["faces"]),
     }
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     try:
@@ -129,12 +116,12 @@ def _load_error_reason(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {first}"
 
 
-def load_model(path, collection=None) -> MeshVAEModel:
-    """Read a checkpoint written by ``model.save(path)``.
-
-    path : the checkpoint file.
-    collection : optional data the model will be used with; a mesh with another vertex count or
-        connectivity (or lacking the model's label columns) raises ValueError.
+def read_checkpoint(path) -> dict:
+    """The model state stored in the checkpoint file ``path`` (numpy arrays where
+    :func:`write_checkpoint` got them; the network's state as tensors), upgraded to the current
+    format. Build the model from it with
+    :meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.from_state_dict` (or call
+    :func:`~meshvae_lib.model.meshvae_model.load_model`, which does both).
 
     Raises FileNotFoundError for a missing file and ValueError for a file that is not a mesh VAE
     checkpoint, is corrupted or truncated, or was written by a newer version.
@@ -164,30 +151,32 @@ def load_model(path, collection=None) -> MeshVAEModel:
         raise ValueError(f"{path} was written by a newer version (checkpoint format {payload['version']},"
                          f" this library reads up to {CHECKPOINT_VERSION})")
     try:
-        ext_state = _to_numpy(payload["extractor"])
-        state = payload["network_state"]
-        if _checksum(state, ext_state["reference"], ext_state["faces"]) != payload["checksum"]:
+        state = {k: (v if k == "network_state" else _to_numpy(v)) for k, v in payload.items()
+                 if k not in ("format", "version", "torch_version", "checksum")}
+        if int(payload["version"]) < 3:
+            state = _upgrade(state)
+        kind = state["kind"]
+        if _checksum(state["network_state"], kind["reference"], kind["faces"]) != payload["checksum"]:
             raise ValueError(f"{path} is corrupted: its weights do not match the stored checksum")
-        config = TrainConfig(**{**payload["train_config"], "progress": False})
-        model = MeshVAEModel(**payload["estimator"], config=config)
-        model.train_config_ = config
-        net_cfg = dict(payload["network_config"])
-        model.network_ = MeshVAE(**net_cfg)
-        model.network_.load_state_dict(state)
-        model.network_.eval()
-        model.normalizer_ = FeatureNormalizer.from_state_dict(_to_numpy(payload["normalizer"]))
-        model.extractor_ = FeatureExtractor.from_state_dict(ext_state)
-        model.conditions_ = ConditionEncoder.from_state_dict(payload["conditions"])
-        model.train_conditions_ = payload["train_conditions"].numpy()
-        model.sigma_object_ = payload["sigma_object"].numpy()
-        model.holdout_mask_ = payload["holdout_mask"].numpy()
-        model.history_ = list(payload["history"])
-        model.train_seconds_ = float(payload["train_seconds"])
-    except (KeyError, TypeError, RuntimeError) as exc:
+    except (KeyError, TypeError, RuntimeError, AttributeError) as exc:
         raise ValueError(f"{path} is an incomplete or inconsistent mesh VAE checkpoint: {exc!r}") from exc
-    sizes = (model.normalizer_.n_features_in_, model.extractor_.n_features_, model.network_.n_features)
-    if len(set(sizes)) != 1 or model.conditions_.n_conditions_ != model.network_.n_conditions:
-        raise ValueError(f"{path} is inconsistent: feature lengths {sizes}")
-    if collection is not None:
-        model.check_compatible(collection)
-    return model
+    return state
+
+
+def _upgrade(state: dict) -> dict:
+    """A state of format 1 or 2 in the layout of format 3: the feature extractor's state becomes the
+    feature kind's, the network is the one architecture there was (``"mesh-vae"``; format 1 has no
+    ``sigma_floor`` and ``output``: the network's defaults), the normalisation half-width is ``a``,
+    and the epochs trained are the last epoch of the history (early stopping's record was not kept)."""
+    state = dict(state)
+    ext = state.pop("extractor")
+    state["kind"] = {"kind": ext["kind"], "reference": ext["reference"], "faces": ext["faces"],
+                     "options": {"layout": ext["layout"]}, "n_features": ext["n_features"]}
+    state["architecture"] = "mesh-vae"
+    config = dict(state["train_config"])
+    config["a"] = config.pop("feature_range", None)
+    state["train_config"] = config
+    history = list(state["history"])
+    state["train_epochs"] = int(history[-1]["epoch"]) if history else 0
+    state["selection"] = None
+    return state

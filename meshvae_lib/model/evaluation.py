@@ -14,7 +14,9 @@ import time
 import numpy as np
 
 from meshvae_lib.geometry.alignment import bounding_box_diagonal, rigid_align
+from meshvae_lib.model.inference import make_inference
 from meshvae_lib.tolerances import PCA_RANK_RTOL
+from meshvae_lib.validation import check_is_fitted, check_vertices
 
 __all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline"]
 
@@ -25,10 +27,9 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
     V_pred, V_true : (N, n, 3) or (n, 3) float. align : first move V_pred rigidly onto V_true.
     Returns (N,) float64 (or a float for single meshes): mean_k |V_pred[k] - V_true[k]|.
     """
-    P = np.asarray(V_pred, dtype=np.float64)
-    T = np.asarray(V_true, dtype=np.float64)
-    if P.shape != T.shape or P.ndim not in (2, 3) or P.shape[-1] != 3:
-        raise ValueError(f"V_pred and V_true must both be (N, n, 3) or (n, 3), got {P.shape} and {T.shape}")
+    P, T = check_vertices(V_pred, "V_pred"), check_vertices(V_true, "V_true")
+    if P.shape != T.shape:
+        raise ValueError(f"V_pred and V_true must have one shape, got {P.shape} and {T.shape}")
     if align:
         P = rigid_align(P, T)
     err = np.linalg.norm(P - T, axis=-1).mean(axis=-1)
@@ -36,53 +37,42 @@ def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
 
 
 def evaluate_model(model, collection, indices=None, held_out_only: bool = False, fit_iterations: int = 0,
-                   inference: str | None = None, progress: bool = False) -> dict:
-    """Reconstruct meshes of ``collection`` (encode, decode) and measure them.
+                   inference=None, progress: bool = False) -> dict:
+    """Reconstruct meshes of ``collection`` (encode, decode) and measure them: the one way to the
+    reconstruction error of a model, held-out (``held_out_only``) or not.
 
     model : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
     indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
         collection must then be the one it was trained on).
-    inference : how the codes are found (``MeshVAEModel.encode_meshes``): None, the model's own
-        (default "gauss-newton": the encoder's mean refined on the vertex error), "encoder" (the
-        paper's feed-forward encoder) or "finite-difference".
-    fit_iterations : k > 0 fits the codes by finite differences with k steps
-        (``MeshVAEModel.fit_latent``; ``meshvae evaluate --fit-latent``).
+    inference : None (the model's own inference: by default "gauss-newton", the encoder's mean
+        refined on the vertex error), a name of :data:`~meshvae_lib.model.inference.METHODS`
+        ("encoder": the paper's feed-forward encoder) or a strategy object.
+    fit_iterations : k > 0 fits the codes by finite differences with k steps (the
+        "finite-difference" strategy; ``meshvae evaluate --fit-latent``).
     progress : a progress bar over the meshes while codes are fitted (seconds per mesh at 10k
         vertices).
 
     Returns a dict: ``mean_vertex_error`` (float, mesh units), ``relative_error`` (mean error /
     bounding-box diagonal of each true mesh, averaged), ``n_meshes``, ``per_mesh`` (list of float),
-    ``names``, ``indices``, ``features`` (the model's feature kind), ``inference`` (the strategy
-    used) and ``seconds_per_mesh`` (encoding and decoding).
+    ``names``, ``indices``, ``features`` (the model's feature kind), ``inference`` (the strategy's
+    name), ``fit_iterations`` (the finite-difference steps; 0 for the other strategies) and
+    ``seconds_per_mesh`` (encoding and decoding).
     """
     model.check_compatible(collection)
     V = np.asarray(collection.vertices, dtype=np.float64)
-    if held_out_only:
-        mask = np.asarray(model.holdout_mask_, dtype=bool)
-        if len(mask) != len(V):
-            raise ValueError(f"the model was trained on {len(mask)} meshes, this collection has {len(V)}:"
-                             " held-out meshes cannot be identified")
-        if not mask.any():
-            raise ValueError("the model was trained without held-out meshes (holdout_every = 0)")
-        idx = np.flatnonzero(mask)
-    else:
-        idx = np.arange(len(V)) if indices is None else np.asarray(indices, dtype=np.int64).ravel()
-    if idx.size == 0:
-        raise ValueError("no meshes to evaluate")
-    if idx.min() < -len(V) or idx.max() >= len(V):
-        raise ValueError(f"indices must lie in 0..{len(V) - 1}, got {idx.min()}..{idx.max()}")
+    idx = _evaluated(model, len(V), indices, held_out_only)
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(collection, "labels", {}) or {}).items()}
     sub = V[idx]
-    lab = labels if model.is_conditional else None
-    # only pass the options when asked: a model-like object need not know them
-    options = {"fit_iterations": fit_iterations} if fit_iterations else {}
-    if inference is not None:
-        options["inference"] = inference
-    if progress:
-        options["progress"] = True
+    if fit_iterations:
+        if inference not in (None, "finite-difference"):
+            raise ValueError(f"fit_iterations is the finite-difference fit; inference {inference!r} was asked for")
+        strategy = make_inference("finite-difference", iterations=fit_iterations)
+    else:
+        strategy = make_inference(model.inference if inference is None else inference)
     start = time.perf_counter()
-    rec = model.reconstruct(sub, labels=lab, **options)
+    rec = model.reconstruct(sub, labels=labels if model.is_conditional else None, inference=strategy,
+                            **({"progress": True} if progress else {}))
     seconds = time.perf_counter() - start
     err = per_vertex_error(rec, sub)
     diag = np.atleast_1d(bounding_box_diagonal(sub))
@@ -94,11 +84,30 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
         "per_mesh": [float(e) for e in err],
         "names": [names[i] for i in idx] if names else [str(i) for i in idx],
         "indices": [int(i) for i in idx],
-        "features": model.extractor_.kind,
-        "fit_iterations": int(fit_iterations),
-        "inference": "finite-difference" if fit_iterations else (inference or getattr(model, "inference", "encoder")),
+        "features": model.feature_kind.name,
+        "fit_iterations": int(strategy.iterations) if strategy.name == "finite-difference" else 0,
+        "inference": strategy.name,
         "seconds_per_mesh": seconds / idx.size,
     }
+
+
+def _evaluated(model, n: int, indices, held_out_only: bool) -> np.ndarray:
+    """The indices of the meshes :func:`evaluate_model` measures, checked."""
+    if held_out_only:
+        mask = np.asarray(model.holdout_mask_, dtype=bool)
+        if len(mask) != n:
+            raise ValueError(f"the model was trained on {len(mask)} meshes, this collection has {n}:"
+                             " held-out meshes cannot be identified")
+        if not mask.any():
+            raise ValueError("the model was trained without held-out meshes (holdout_every = 0)")
+        idx = np.flatnonzero(mask)
+    else:
+        idx = np.arange(n) if indices is None else np.asarray(indices, dtype=np.int64).ravel()
+    if idx.size == 0:
+        raise ValueError("no meshes to evaluate")
+    if idx.min() < -n or idx.max() >= n:
+        raise ValueError(f"indices must lie in 0..{n - 1}, got {idx.min()}..{idx.max()}")
+    return idx
 
 
 class CoordinatePCA:
@@ -132,11 +141,8 @@ class CoordinatePCA:
         self.aligned = aligned
 
     def _rows(self, V) -> np.ndarray:
-        V = np.asarray(V, dtype=np.float64)
-        if V.ndim == 2:
-            V = V[None]
-        if V.ndim != 3 or V.shape[-1] != 3:
-            raise ValueError(f"meshes must have shape (N, n_vertices, 3), got {V.shape}")
+        V = check_vertices(V, "meshes")
+        V = V[None] if V.ndim == 2 else V
         if hasattr(self, "reference_") and V.shape[1] != len(self.reference_):
             raise ValueError(f"the PCA was fitted on meshes of {len(self.reference_)} vertices, got {V.shape[1]}")
         if self.aligned:
@@ -145,8 +151,8 @@ class CoordinatePCA:
 
     def fit(self, V_train) -> "CoordinatePCA":
         """V_train : (N, n, 3) float training meshes, N >= 2. Returns ``self``."""
-        V = np.asarray(V_train, dtype=np.float64)
-        if V.ndim != 3 or V.shape[-1] != 3 or len(V) < 2:
+        V = check_vertices(V_train, "V_train", batch=True)
+        if len(V) < 2:
             raise ValueError(f"need (N >= 2, n_vertices, 3) training meshes, got {V.shape}")
         self.reference_ = V[0].copy()
         X = self._rows(V)
@@ -162,12 +168,12 @@ class CoordinatePCA:
 
     def transform(self, V) -> np.ndarray:
         """Meshes (N, n, 3) -> principal coefficients (N, k) float64."""
-        self._check_fitted()
+        check_is_fitted(self, "components_", "call fit(V_train) first")
         return (self._rows(V) - self.mean_) @ self.components_.T
 
     def inverse_transform(self, Z) -> np.ndarray:
         """Coefficients (N, k) -> meshes (N, n, 3) float64 (in the aligned frame when ``aligned``)."""
-        self._check_fitted()
+        check_is_fitted(self, "components_", "call fit(V_train) first")
         Z = np.atleast_2d(np.asarray(Z, dtype=np.float64))
         return (Z @ self.components_ + self.mean_).reshape(len(Z), -1, 3)
 
@@ -175,9 +181,6 @@ class CoordinatePCA:
         """Project meshes (N, n, 3) onto the model and back: (N, n, 3) float64."""
         return self.inverse_transform(self.transform(V))
 
-    def _check_fitted(self) -> None:
-        if not hasattr(self, "components_"):
-            raise ValueError("this CoordinatePCA is not fitted yet: call fit(V_train) first")
 
 
 def pca_baseline(V_train, V_eval, n_components: int | None = None, aligned: bool = False) -> dict:

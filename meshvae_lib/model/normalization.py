@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from meshvae_lib.tolerances import NORMALIZE_EPS
 from meshvae_lib.defaults import NORMALIZE_A
+from meshvae_lib.tolerances import NORMALIZE_EPS
+from meshvae_lib.validation import check_choice, check_finite, check_is_fitted, check_rows
 
 __all__ = ["FeatureNormalizer", "SCALES"]
 
@@ -70,8 +71,7 @@ class FeatureNormalizer:
             raise ValueError(f"a must lie in (0, 1) so that tanh can reach it, got {self.a}")
         if not float(self.eps) > 0.0:
             raise ValueError(f"eps must be positive, got {self.eps}")
-        if self.scale not in SCALES:
-            raise ValueError(f"scale must be one of {SCALES}, got {self.scale!r}")
+        check_choice(self.scale, SCALES, "scale")
         X = self._check_rows(X, fitted=False)
         lo = X.min(axis=0)
         hi = X.max(axis=0)
@@ -109,7 +109,7 @@ class FeatureNormalizer:
     # -- persistence ---------------------------------------------------------------------------
     def state_dict(self) -> dict:
         """Everything needed to rebuild the fitted normaliser: plain floats and float64 arrays."""
-        self._check_fitted()
+        check_is_fitted(self, "min_", "call fit(X) first")
         return {"a": float(self.a), "eps": float(self.eps), "scale": str(self.scale),
                 "min": self.min_.copy(), "max": self.max_.copy()}
 
@@ -128,16 +128,10 @@ class FeatureNormalizer:
         return norm
 
     # -- helpers -------------------------------------------------------------------------------
-    def _check_fitted(self) -> None:
-        if not hasattr(self, "min_"):
-            raise ValueError("this FeatureNormalizer is not fitted yet: call fit(X) first")
-
     def _check_rows(self, X, fitted: bool) -> np.ndarray:
-        X = np.asarray(X, dtype=np.float64)
-        if X.ndim != 2 or X.shape[0] < 1 or X.shape[1] < 1:
+        X = check_finite(check_rows(X, "features", single=False), "features")
+        if X.shape[0] < 1 or X.shape[1] < 1:
             raise ValueError(f"features must have shape (n_meshes, n_features), got {X.shape}")
-        if not np.all(np.isfinite(X)):
-            raise ValueError(f"features hold {int(np.sum(~np.isfinite(X)))} non-finite values")
         if fitted and X.shape[1] != self.n_features_in_:
             raise ValueError(
                 f"features have {X.shape[1]} components, the normaliser was fitted on {self.n_features_in_}"
@@ -145,7 +139,7 @@ class FeatureNormalizer:
         return X
 
     def _prepare(self, X):
-        self._check_fitted()
+        check_is_fitted(self, "min_", "call fit(X) first")
         X = np.asarray(X, dtype=np.float64)
         single = X.ndim == 1
         if single:

@@ -1,33 +1,50 @@
-"""The training configuration of the mesh VAE (every option of :func:`~meshvae_lib.model.training.train_vae`)
-and the default network size per feature kind.
+"""The training configuration of the mesh VAE (every option of :func:`~meshvae_lib.model.training.train_vae`),
+the default network size per feature kind and the prior deviations sigma_object padded to the latent size.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_INIT,
-                                  DEFAULT_LATENT, DEFAULT_LR, EARLY_STOPPING_PATIENCE, HIDDEN_COORDS, INIT_MODES,
-                                  LOSSES, NORMALIZE_A, OUTPUTS, PCA_FEATURE_RANGE, PRIOR_FORMS, VALIDATION_EVERY)
+import numpy as np
 
-__all__ = ["TrainConfig", "default_hidden"]
+from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_ARCHITECTURE, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS,
+                                  DEFAULT_FEATURE_KIND, DEFAULT_INIT, DEFAULT_LATENT, DEFAULT_LR,
+                                  EARLY_STOPPING_PATIENCE, INIT_MODES, LOSSES, NORMALIZE_A, OUTPUTS,
+                                  PCA_NORMALIZE_A, PRIOR_FORMS, VALIDATION_EVERY)
+from meshvae_lib.model.feature_kinds import kind_class
+from meshvae_lib.model.networks import ARCHITECTURES
+from meshvae_lib.validation import check_choice
+
+__all__ = ["TrainConfig", "default_hidden", "pad_sigma_object"]
 
 
-def default_hidden(kind: str = "rimd", init: str = "pca") -> tuple[int, ...]:
+def default_hidden(kind: str = DEFAULT_FEATURE_KIND, init: str = DEFAULT_INIT) -> tuple[int, ...]:
     """Internal layer sizes that did best for each feature kind (measured: see docs/vae.md).
 
-    With the paper's random initialisation: none for RIMD, HIDDEN_COORDS for the coordinate
-    baselines. With the PCA initialisation (``init="pca"``, see ``TrainConfig.init``): none for
-    every kind, since a network without internal layers then starts at the linear floor, and on the
-    real collections nothing trained from a random start came near it (docs/vae.md, issue 12).
+    With the paper's random initialisation: the kind's ``random_hidden`` (none for RIMD,
+    ``defaults.HIDDEN_COORDS`` for the coordinate baselines). With the PCA initialisation
+    (``init="pca"``, see ``TrainConfig.init``): none for every kind, since a network without
+    internal layers then starts at the linear floor, and on the real collections nothing trained
+    from a random start came near it (docs/vae.md, issue 12).
     """
-    if init not in INIT_MODES:
-        raise ValueError(f"unknown init {init!r}; expected one of {INIT_MODES}")
-    if kind not in ("rimd", "coords", "aligned"):
-        raise ValueError(f"unknown feature kind {kind!r}")
-    if kind == "rimd" or init == "pca":
-        return ()
-    return tuple(HIDDEN_COORDS)
+    check_choice(init, INIT_MODES, "init")
+    hidden = kind_class(kind).random_hidden
+    return () if init == "pca" else tuple(hidden)
+
+
+def pad_sigma_object(sigma_object, latent_dim: int) -> np.ndarray | None:
+    """Prior deviations sigma_object (Sec. 4.4) of length <= D, padded with 1 to (D,) float64
+    (``defaults.EMBEDDING_SIGMA_OBJECT`` and ``EXPLORATION_SIGMA_OBJECT`` are such heads); None
+    stays None."""
+    if sigma_object is None:
+        return None
+    s = np.asarray(sigma_object, dtype=np.float64).ravel()
+    if s.size > latent_dim:
+        raise ValueError(f"sigma_object has {s.size} entries but the latent size is {latent_dim}")
+    if not np.all(np.isfinite(s)) or np.any(s <= 0):
+        raise ValueError(f"sigma_object entries must be positive and finite, got {s.tolist()}")
+    return np.concatenate([s, np.ones(latent_dim - s.size)])
 
 
 @dataclass
@@ -51,21 +68,24 @@ class TrainConfig:
     progress : show a tqdm progress bar (terminal or notebook).
     eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
         how often early stopping looks at its validation meshes.
+    architecture : the network (a name of :data:`~meshvae_lib.model.networks.ARCHITECTURES`;
+        default ``"mesh-vae"``, :class:`~meshvae_lib.model.vae.MeshVAE`).
     init : "pca" (default) or "random" (PyTorch's initialisation: the paper's training; with
         ``early_stopping=False`` all ``epochs`` are trained, as the paper does). The PCA start is
         the library's departure from the paper: on real meshes the paper's training generalised
         2-6x worse than PCA of the coordinates (docs/vae.md, "Generalisation on real meshes").
         "pca": an unconditional network without internal layers
         and with the standard prior (``hidden=()``, ``sigma_object=None``) is built by
-        :func:`pca_network`:
+        :meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`:
         its encoder sees the whitened principal coefficients of the training features and its
         decoder starts as the PCA reconstruction, so training starts at the linear floor. Other
         networks (internal layers, a sigma_object prior) and ``"random"`` use PyTorch's random
         initialisation on the K features (the paper's network); so do conditional networks, whose
         use of the condition has to be learned.
-    feature_range : half-width a of the normalised range (Eq. 3) that
-        :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` uses. None: PCA_FEATURE_RANGE (0.3) for
-        PCA-initialised networks, the paper's 0.9 otherwise.
+    a : the half-width a of the normalised range [-a, a] (Eq. 3) that
+        :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` normalises to and a sigmoid output is
+        mapped from. None: ``defaults.PCA_NORMALIZE_A`` (0.3) for PCA-initialised networks, the
+        paper's ``NORMALIZE_A`` (0.9) otherwise (:meth:`resolved_a`).
     early_stopping : None (default: on for PCA-initialised networks), True or False. When on and
         there are at least ``2 * validation_every`` training rows, every ``validation_every``-th
         row is set aside, a network is trained on the others and evaluated on them (feature MSE,
@@ -74,8 +94,9 @@ class TrainConfig:
         number of epochs (which may be 0: the initialisation itself). ``epochs`` is the maximum.
     validation_every, patience : see ``early_stopping``.
     feature_scale : "component" (the paper's Eq. 3) or "shared" (one half-width for all components,
-        see :class:`~meshvae_lib.model.normalization.FeatureNormalizer`). None: "shared" for coordinate
-        features (``"coords"``, ``"aligned"``) of PCA-initialised networks, "component" otherwise.
+        see :class:`~meshvae_lib.model.normalization.FeatureNormalizer`). None: the feature kind's
+        ``pca_scale`` for PCA-initialised networks ("shared" for the coordinate kinds), "component"
+        otherwise.
     sigma_floor, output : the new network's options (see :class:`~meshvae_lib.model.vae.MeshVAE`):
         a floor added to the deviation (default 0) and the decoder's last activation, "tanh"
         (default) or "sigmoid". A sigmoid network is trained on the rows mapped to
@@ -97,7 +118,7 @@ class TrainConfig:
     progress: bool = True
     eval_every: int = 10
     init: str = DEFAULT_INIT
-    feature_range: float | None = None
+    a: float | None = None
     early_stopping: bool | None = None
     validation_every: int = VALIDATION_EVERY
     patience: int = EARLY_STOPPING_PATIENCE
@@ -105,30 +126,34 @@ class TrainConfig:
     sigma_floor: float = 0.0
     output: str = "tanh"
     loss: str = "mse"
+    architecture: str = DEFAULT_ARCHITECTURE
 
+    # The resolvers: what the options left at None mean for a network with ``n_conditions``
+    # condition inputs (the estimator and the trainer both ask these, nobody else decides).
     def uses_pca_init(self, n_conditions: int = 0) -> bool:
-        """True when a new network is built by :func:`pca_network` (see ``init``)."""
+        """True when a new network starts at the PCA of its rows (:meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`;
+        see ``init``)."""
         return (self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
                 and self.output == "tanh")
 
-    def resolved_feature_range(self, pca: bool | None = None) -> float:
-        """a of Eq. 3 for this config (``pca``: whether the PCA initialisation applies; None: ask)."""
-        if self.feature_range is not None:
-            return float(self.feature_range)
-        pca = self.uses_pca_init() if pca is None else pca
-        return PCA_FEATURE_RANGE if pca else NORMALIZE_A
+    def resolved_a(self, n_conditions: int = 0) -> float:
+        """a of Eq. 3 (see ``a``)."""
+        if self.a is not None:
+            return float(self.a)
+        return PCA_NORMALIZE_A if self.uses_pca_init(n_conditions) else NORMALIZE_A
 
-    def resolved_feature_scale(self, kind: str, pca: bool | None = None) -> str:
-        """How :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` sets the ranges of Eq. 3 for ``kind``."""
+    def resolved_feature_scale(self, kind: str, n_conditions: int = 0) -> str:
+        """How :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` sets the ranges of Eq. 3 for
+        the feature kind ``kind`` (see ``feature_scale``)."""
         if self.feature_scale is not None:
             return self.feature_scale
-        pca = self.uses_pca_init() if pca is None else pca
-        return "shared" if pca and kind in ("coords", "aligned") else "component"
+        return kind_class(kind).pca_scale if self.uses_pca_init(n_conditions) else "component"
 
-    def resolved_early_stopping(self, pca: bool | None = None) -> bool:
+    def resolved_early_stopping(self, n_conditions: int = 0) -> bool:
+        """Whether a new network's epochs are chosen by early stopping (see ``early_stopping``)."""
         if self.early_stopping is not None:
             return bool(self.early_stopping)
-        return self.uses_pca_init() if pca is None else bool(pca)
+        return self.uses_pca_init(n_conditions)
 
     def __post_init__(self):
         self.hidden = tuple(int(h) for h in self.hidden)
@@ -144,13 +169,14 @@ class TrainConfig:
             "eval_every": self.eval_every >= 1,
             "prior_form": self.prior_form in PRIOR_FORMS,
             "init": self.init in INIT_MODES,
-            "feature_range": self.feature_range is None or 0.0 < float(self.feature_range) < 1.0,
+            "a": self.a is None or 0.0 < float(self.a) < 1.0,
             "validation_every": self.validation_every >= 2,
             "patience": self.patience >= 1,
             "feature_scale": self.feature_scale in (None, "component", "shared"),
             "sigma_floor": 0.0 <= float(self.sigma_floor) < float("inf"),
             "output": self.output in OUTPUTS,
             "loss": self.loss in LOSSES and (self.loss != "bce" or self.output == "sigmoid"),
+            "architecture": self.architecture in ARCHITECTURES,
         }
         for name, ok in checks.items():
             if not ok:

@@ -12,7 +12,7 @@ D -> K, so there are no internal layers.
 Input projection (``input_rank = r > 0``, a departure from the paper, issue 12): the encoder does
 not see the K features themselves but their r whitened principal coefficients
 ``(x - input_mean) @ input_basis.T``, a fixed linear map onto the span of the training features
-(set by :func:`meshvae_lib.model.training.pca_network`, stored in the checkpoint as buffers). On real
+(set by :meth:`MeshVAE.from_pca`, stored in the checkpoint as buffers). On real
 collections 4-35% of a held-out mesh's (centred) feature energy lies outside the span of the
 training meshes; a K-wide encoder trained with Adam gives those directions arbitrary weights
 (Adam's per-weight steps leave the span), and held-out meshes get arbitrary latent codes.
@@ -37,74 +37,16 @@ from __future__ import annotations
 
 from typing import Sequence
 
+import numpy as np
 import torch
 from torch import nn
 
-from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, OUTPUTS, PRIOR_FORMS, SIGMA_MAX
+from meshvae_lib.model.inplace_grad import Linear
+from meshvae_lib.model.pca_start import pca_start
+from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
 
-__all__ = ["MeshVAE", "kl_divergence", "vae_loss", "start_step", "Linear"]
-
-
-class _LinearGradInPlace(torch.autograd.Function):
-    """y = x W^T + b whose backward adds dL/dW into the existing ``W.grad`` buffer.
-
-    For K ~ 165k the weight gradients are 85-170 MB each. Letting autograd allocate them afresh at
-    every step costs more than the matrix products themselves (fresh pages from the OS: measured
-    130 ms against 35 ms for the same product into a kept buffer, 2 CPU threads). Keeping
-    ``W.grad`` allocated (``optimizer.zero_grad(set_to_none=False)``, as :func:`train_vae` does) and
-    accumulating into it with ``addmm_`` avoids that; the gradient is the same.
-    """
-
-    @staticmethod
-    def forward(ctx, x, weight, bias):
-        ctx.save_for_backward(x, weight)
-        return torch.nn.functional.linear(x, weight, bias)
-
-    @staticmethod
-    def backward(ctx, grad_out):
-        x, weight = ctx.saved_tensors
-        grad_x = grad_out @ weight if ctx.needs_input_grad[0] else None
-        if ctx.needs_input_grad[1]:
-            if weight.grad is None:
-                weight.grad = torch.zeros_like(weight)
-                weight._overwrite_grad = False
-            if getattr(weight, "_overwrite_grad", False):  # set by start_step: a fresh step
-                torch.mm(grad_out.t(), x, out=weight.grad)
-                weight._overwrite_grad = False
-            else:
-                weight.grad.addmm_(grad_out.t(), x)
-        grad_b = grad_out.sum(0) if ctx.needs_input_grad[2] else None
-        return grad_x, None, grad_b
-
-
-class Linear(nn.Linear):
-    """``nn.Linear`` whose weight gradient accumulates in place (see :class:`_LinearGradInPlace`).
-
-    Same parameters, same state dict, same values and gradients as ``nn.Linear``.
-    """
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        if torch.is_grad_enabled() and self.weight.requires_grad and self.bias is not None:
-            return _LinearGradInPlace.apply(x, self.weight, self.bias)
-        return super().forward(x)
-
-
-def start_step(module: nn.Module) -> None:
-    """Reset gradients before a training step, keeping the big weight-gradient buffers.
-
-    Equivalent to ``optimizer.zero_grad(set_to_none=False)`` but cheaper: the weight gradients of
-    this module's :class:`Linear` layers are not zeroed (170 MB of memset at K ~ 165k) but marked
-    to be overwritten, rather than accumulated into, by the next backward pass.
-    """
-    marked = set()
-    for m in module.modules():
-        if isinstance(m, Linear) and m.weight.grad is not None:
-            m.weight._overwrite_grad = True
-            marked.add(id(m.weight))
-    for p in module.parameters():
-        if p.grad is not None and id(p) not in marked:
-            p.grad.zero_()
+__all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
 
 
 def _block(n_in: int, n_out: int, slope: float) -> list[nn.Module]:
@@ -112,7 +54,8 @@ def _block(n_in: int, n_out: int, slope: float) -> list[nn.Module]:
 
 
 class MeshVAE(nn.Module):
-    """Fully connected (conditional) variational autoencoder on normalised mesh features.
+    """Fully connected (conditional) variational autoencoder on normalised mesh features: the
+    ``"mesh-vae"`` architecture of :mod:`meshvae_lib.model.networks`.
 
     Parameters
     ----------
@@ -139,6 +82,9 @@ class MeshVAE(nn.Module):
         the decoder's last activation: tanh (the paper, features in [-a, a]) or sigmoid (outputs in
         (0, 1), for the binary cross-entropy loss).
     """
+
+    #: the architecture's name in :data:`meshvae_lib.model.networks.ARCHITECTURES`.
+    architecture = "mesh-vae"
 
     def __init__(
         self,
@@ -214,6 +160,63 @@ class MeshVAE(nn.Module):
             "output": self.output,
         }
 
+    @classmethod
+    def from_config(cls, config: dict) -> "MeshVAE":
+        """The network :meth:`config` describes (untrained weights)."""
+        return cls(**config)
+
+    @classmethod
+    def start(cls, x: torch.Tensor, n_conditions: int, config) -> "MeshVAE":
+        """A new network to train on rows ``x (N, K)`` float32 with ``config`` (a
+        :class:`~meshvae_lib.model.train_config.TrainConfig`): the PCA start (:meth:`from_pca`) when
+        ``config.uses_pca_init(n_conditions)``, else PyTorch's random initialisation (seeded by the
+        caller)."""
+        if config.uses_pca_init(n_conditions):
+            return cls.from_pca(x, config, n_conditions)
+        return cls(x.shape[1], config.latent_dim, config.hidden, n_conditions, sigma_floor=config.sigma_floor,
+                   output=config.output)
+
+    @classmethod
+    def from_pca(cls, x: torch.Tensor, config, n_conditions: int = 0) -> "MeshVAE":
+        """A network without internal layers whose decoded means start as the training rows' PCA.
+
+        x : (N, K) float32 normalised training rows (N >= 2); config : the latent size, alpha and
+        sigma_floor come from it (``config.hidden`` must be empty, ``config.output`` "tanh"). The
+        input projection, encoder and decoder start as :func:`~meshvae_lib.model.pca_start.pca_start`
+        says (the deviation is 1 in the latent dimensions beyond its rank, where the latent cost is
+        then 0); condition inputs start with zero weights. Returns the network in train mode.
+        """
+        if config.hidden:
+            raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
+        if config.output != "tanh":
+            raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
+        start = pca_start(x.detach().double().cpu().numpy(), config.latent_dim, config.alpha)
+        r, D = start.rank, config.latent_dim
+        net = cls(x.shape[1], D, (), n_conditions, input_rank=r, sigma_floor=config.sigma_floor)
+        sigma_logit = np.log(start.sigma / (net.sigma_max - start.sigma))
+        f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
+        with torch.no_grad():
+            net.input_mean.copy_(f32(start.mean))
+            net.input_basis.copy_(f32(start.basis))
+            net.encoder_head.weight.zero_()
+            net.encoder_head.bias.zero_()
+            net.encoder_head.weight[:r, :r] = torch.eye(r)
+            net.encoder_head.bias[D:] = float(np.log(1.0 / (net.sigma_max - 1.0)))  # sigma = 1
+            net.encoder_head.bias[D:D + r] = f32(sigma_logit)
+            net.decoder_head.weight.zero_()
+            net.decoder_head.weight[:, :r] = f32(start.decoder_weight)
+            net.decoder_head.bias.copy_(f32(start.decoder_bias))
+        return net
+
+    def used_latent_dims(self) -> np.ndarray:
+        """Indices (int64) of the latent dimensions the decoder reads: with no internal layer, those
+        whose column of the decoder's weight is not all zero (the PCA start leaves the others at
+        zero); with internal layers, all of them."""
+        if self.hidden:
+            return np.arange(self.latent_dim)
+        W = self.decoder_head.weight.detach()
+        return np.flatnonzero(W[:, : self.latent_dim].abs().sum(0).numpy() > 0)
+
     def _with_condition(self, x: torch.Tensor, c, width: int, what: str) -> torch.Tensor:
         if x.ndim != 2 or x.shape[1] != width:
             raise ValueError(f"{what} must have shape (batch, {width}), got {tuple(x.shape)}")
@@ -276,7 +279,6 @@ class MeshVAE(nn.Module):
         mu, sigma = self.encode(x, c)
         z = self.reparameterize(mu, sigma, generator)
         return self.decode(z, c), mu, sigma
-
 
 
 def kl_divergence(

@@ -42,7 +42,7 @@ from meshvae_lib.paper.generation import generation_table
 from meshvae_lib.paper.interpolation import interpolation_table
 from meshvae_lib.paper.latent_size import latent_size_table
 from meshvae_lib.paper.loss import loss_table
-from meshvae_lib.paper.protocol import CollectionData, load_collection
+from meshvae_lib.paper.protocol import collection_fingerprint, load_collection
 from meshvae_lib.paper.robustness import robustness_table
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings
 from meshvae_lib.paper.tables import ExperimentTable, RecordedResults, definition_fingerprint, read_results
@@ -51,7 +51,7 @@ __all__ = [
     "ExperimentSettings",
     "ExperimentTable",
     "PAPER",
-    "CollectionData",
+    "collection_fingerprint",
     "load_collection",
     "latent_size_table",
     "feature_table",

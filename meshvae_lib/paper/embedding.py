@@ -3,11 +3,55 @@
 from __future__ import annotations
 
 from meshvae_lib import defaults as hp
+from meshvae_lib.model.train_config import pad_sigma_object
 from meshvae_lib.paper.protocol import load_collection, name_of, timed, train_model
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
 __all__ = ["embedding_table"]
+
+
+def _vae_runs(coll, s, cache, labels, relevance, seeds, prior, alpha, hidden, epochs):
+    """One sigma_object VAE per seed: ``({seed: (embedding, PR result)}, the median seed, the last
+    model)``."""
+    from meshvae_lib.applications import retrieval as ret
+
+    so = pad_sigma_object(hp.EMBEDDING_SIGMA_OBJECT, s.latent_dim)
+    out = {}
+    for sd in seeds:
+        m = train_model(coll, s, cache, sigma_object=so, holdout=False, prior=prior, alpha=alpha, hidden=hidden,
+                        seed=sd, epochs=epochs)
+        y = m.encode_meshes(coll.vertices, inference="encoder")[:, :2]
+        out[sd] = (y, ret.precision_recall_curve(y, labels, relevance=relevance))
+    order = sorted(seeds, key=lambda sd: out[sd][1].auc["mean"])
+    return out, order[(len(order) - 1) // 2], m
+
+
+def _baselines(X, labels, relevance, seed) -> tuple[dict, dict]:
+    """t-SNE, PCA and NPE of the rows ``X``: ({method: embedding}, {method: PR result})."""
+    from meshvae_lib.applications import embedding as emb
+    from meshvae_lib.applications import retrieval as ret
+
+    k = min(hp.NPE_N_NEIGHBORS, len(X) - 1)
+    Y = {
+        "t-SNE": emb.tsne_embedding(X, seed=seed),
+        "PCA": emb.pca_embedding(X, seed=seed),
+        "NPE": emb.NeighborhoodPreservingEmbedding(2, n_neighbors=k).fit_transform(X),
+    }
+    return Y, {m: ret.precision_recall_curve(y, labels, relevance=relevance) for m, y in Y.items()}
+
+
+def _table(name, Y, curves, labels, seed_aucs, seeds) -> ExperimentTable:
+    from meshvae_lib.applications import retrieval as ret
+
+    cols = ["method", "AUC (mean)"] + [f"AUC {c}" for c in labels] + ["AUC joint", "seeds (min-max)", "paper AUC"]
+    table = ExperimentTable("embedding_auc", f"Sec. 5.4: retrieval AUC of 2D embeddings ({name})", cols)
+    for m, y in Y.items():
+        res = curves[m]
+        joint = ret.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
+        spread = (f"{min(seed_aucs[m]):.4f}-{max(seed_aucs[m]):.4f}" if m in seed_aucs and len(seeds) > 1 else None)
+        table.rows.append([m, res.auc["mean"]] + [res.auc[c] for c in labels] + [joint, spread, PAPER["auc"].get(m)])
+    return table
 
 
 @timed
@@ -29,9 +73,6 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     Extra rows: ``compare_exact`` -- the same model with the exact KL; ``compare_paper_defaults`` --
     the sibling form with the paper's general settings (alpha = 1e6, no internal layer).
     """
-    from meshvae_lib.applications import embedding as emb
-    from meshvae_lib.applications import retrieval as ret
-
     s = resolve_settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
     labels = {c: coll.labels[c] for c in label_columns if c in coll.labels}
@@ -41,31 +82,14 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     seeds = [int(x) for x in seeds]
     if not seeds:
         raise ValueError("give at least one seed")
-    so = emb.embedding_sigma_object(s.latent_dim)
     ep = s.embedding_epochs_for(len(coll.vertices))
+    runs = lambda prior, a, h: _vae_runs(coll, s, cache, labels, relevance, seeds, prior, a, h, ep)  # noqa: E731
 
-    def vae_rows(prior, a, h):
-        """{seed: (embedding, PR result)} for one configuration, the median seed, and one model."""
-        out = {}
-        for sd in seeds:
-            m = train_model(coll, s, cache, sigma_object=so, holdout=False, prior=prior, alpha=a, hidden=h, seed=sd,
-                            epochs=ep)
-            y = m.encode_meshes(coll.vertices, inference="encoder")[:, :2]
-            out[sd] = (y, ret.precision_recall_curve(y, labels, relevance=relevance))
-        order = sorted(seeds, key=lambda sd: out[sd][1].auc["mean"])
-        return out, order[(len(order) - 1) // 2], m
-
-    ours, med, model = vae_rows("sibling", alpha, hidden)
+    ours, med, model = runs("sibling", alpha, hidden)
     X = model.features_of(coll.vertices)  # the normalised rows every model saw (fitted on all meshes)
-    k = min(hp.NPE_N_NEIGHBORS, len(X) - 1)
-    Y = {
-        "sigma_object VAE": ours[med][0],
-        "t-SNE": emb.tsne_embedding(X, seed=s.seed),
-        "PCA": emb.pca_embedding(X, seed=s.seed),
-        "NPE": emb.NeighborhoodPreservingEmbedding(2, n_neighbors=k).fit_transform(X),
-    }
-    curves = {m: (ours[med][1] if m == "sigma_object VAE" else ret.precision_recall_curve(y, labels, relevance=relevance))
-              for m, y in Y.items()}
+    base, base_curves = _baselines(X, labels, relevance, s.seed)
+    Y = {"sigma_object VAE": ours[med][0], **base}
+    curves = {"sigma_object VAE": ours[med][1], **base_curves}
     seed_aucs = {"sigma_object VAE": [ours[sd][1].auc["mean"] for sd in seeds]}
     extra = []
     if compare_exact:
@@ -73,17 +97,11 @@ def embedding_table(collection: str = "dyna", label_columns=("shape", "motion"),
     if compare_paper_defaults:
         extra.append(("sigma_object VAE, alpha 1e6, no hidden layer", "sibling", hp.DEFAULT_ALPHA, ()))
     for name, prior, a, h in extra:
-        runs, m, _ = vae_rows(prior, a, h)
-        Y[name], curves[name] = runs[m]
-        seed_aucs[name] = [runs[sd][1].auc["mean"] for sd in seeds]
+        other, m, _ = runs(prior, a, h)
+        Y[name], curves[name] = other[m]
+        seed_aucs[name] = [other[sd][1].auc["mean"] for sd in seeds]
 
-    cols = ["method", "AUC (mean)"] + [f"AUC {c}" for c in labels] + ["AUC joint", "seeds (min-max)", "paper AUC"]
-    table = ExperimentTable("embedding_auc", f"Sec. 5.4: retrieval AUC of 2D embeddings ({name_of(collection)})", cols)
-    for m, y in Y.items():
-        res = curves[m]
-        joint = ret.retrieval_auc(y, labels, relevance="joint") if len(labels) > 1 else res.auc["mean"]
-        spread = (f"{min(seed_aucs[m]):.4f}-{max(seed_aucs[m]):.4f}" if m in seed_aucs and len(seeds) > 1 else None)
-        table.rows.append([m, res.auc["mean"]] + [res.auc[c] for c in labels] + [joint, spread, PAPER["auc"].get(m)])
+    table = _table(name_of(collection), Y, curves, labels, seed_aucs, seeds)
     table.data.update(embeddings=Y, labels=labels, curves=curves, seed_aucs=seed_aucs, seeds=seeds, median_seed=med,
                       alpha=float(alpha), hidden=tuple(hidden), epochs=ep)
     ours_auc = table.rows[0][1]

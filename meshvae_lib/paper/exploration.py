@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib import defaults as hp
+from meshvae_lib.model.train_config import pad_sigma_object
 from meshvae_lib.paper.protocol import load_collection, name_of, timed, train_model
 from meshvae_lib.paper.settings import ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
@@ -30,8 +31,8 @@ def exploration_table(collection: str = "scape", dims=(0, 1, 2, 3), grid: int = 
     s = resolve_settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
     ep = s.embedding_epochs_for(len(coll.vertices))
-    model = train_model(coll, s, cache, sigma_object=ex.exploration_sigma_object(s.latent_dim), holdout=False,
-                        prior="sibling", alpha=hp.EMBEDDING_ALPHA, hidden=hp.EMBEDDING_HIDDEN, epochs=ep)
+    model = train_model(coll, s, cache, sigma_object=pad_sigma_object(hp.EXPLORATION_SIGMA_OBJECT, s.latent_dim),
+                        holdout=False, prior="sibling", alpha=hp.EMBEDDING_ALPHA, hidden=hp.EMBEDDING_HIDDEN, epochs=ep)
     rest = np.asarray(coll.extras.get("rest", coll.vertices[0]), dtype=np.float64)  # the A-pose template
     regions = ex.humanoid_regions(rest)
     measure = lambda V: ex.measure_humanoid(V, regions)  # noqa: E731

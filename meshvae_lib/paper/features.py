@@ -5,7 +5,9 @@ from __future__ import annotations
 import logging
 from typing import Sequence
 
-from meshvae_lib.paper.protocol import (available, heldout_error, load_collection, name_of, registry_names, timed,
+from meshvae_lib.model.evaluation import evaluate_model
+from meshvae_lib.model.feature_kinds import FEATURE_KINDS
+from meshvae_lib.paper.protocol import (available, load_collection, name_of, registry_names, timed,
                                         train_model)
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
@@ -16,7 +18,7 @@ logger = logging.getLogger(__name__)
 
 
 @timed
-def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "aligned", "rimd"),
+def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
                   settings: ExperimentSettings | None = None, quick: bool = False,
                   cache: dict | None = None) -> ExperimentTable:
     """Paper Table 2: held-out error with 3D coordinates, aligned coordinates and RIMD features.
@@ -41,11 +43,12 @@ def feature_table(collections: Sequence[str] | None = None, kinds=("coords", "al
         name = name_of(entry)
         coll = load_collection(entry, s, cache=cache)
         models = {k: train_model(coll, s, cache, features=k) for k in kinds}
-        errs = {k: heldout_error(m, coll)["mean_vertex_error"] for k, m in models.items()}
+        errs = {k: evaluate_model(m, coll, held_out_only=True, inference="encoder")["mean_vertex_error"]
+                for k, m in models.items()}
         table.data["errors"][name] = errs
         gn_cell = []
         if gn:
-            gn_err = heldout_error(models["rimd"], coll, inference="gauss-newton")["mean_vertex_error"]
+            gn_err = evaluate_model(models["rimd"], coll, held_out_only=True, inference="gauss-newton")["mean_vertex_error"]
             table.data.setdefault("rimd_gauss_newton", {})[name] = gn_err
             gn_cell = [gn_err]
         logger.info("table 2, %s [%d meshes]: %s", name, len(coll.vertices),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from meshvae_lib.paper.protocol import CollectionData, available, load_collection, name_of, timed, train_model
+from meshvae_lib.paper.protocol import available, load_collection, name_of, timed, train_model
 from meshvae_lib.paper.settings import ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
@@ -27,14 +27,13 @@ def generation_table(collection: str = "scape", n: int = 8, conditional_collecti
     (on ``condition_column``), the share of generated meshes whose nearest training mesh carries
     the asked label, against the unconditional model's share.
     """
-    from meshvae_lib.applications.generation import generate
+    from meshvae_lib.applications.generation import nearest_training_meshes
 
     s = resolve_settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
     model = train_model(coll, s, cache)
-    train = ~model.holdout_mask_
-    ds = CollectionData(coll.vertices[train], coll.faces, [], {k: v[train] for k, v in coll.labels.items()})
-    res = generate(model, n, seed=s.seed, dataset=ds)
+    ds = coll.subset(~model.holdout_mask_)
+    res = nearest_training_meshes(model, n, ds, seed=s.seed)
     table = ExperimentTable("generation", "Sec. 5.2: generated meshes and their nearest training meshes",
                             ["model", "generated", "median NN distance", "min NN distance",
                              "training median NN distance", "median novelty", "label match"])
@@ -47,8 +46,8 @@ def generation_table(collection: str = "scape", n: int = 8, conditional_collecti
             value = values[np.argmax(counts)]
             plain = train_model(dc, s, cache, holdout=False)
             cond = train_model(dc, s, cache, labels=(condition_column,), holdout=False)
-            r_plain = generate(plain, n, seed=s.seed, dataset=dc)
-            r_cond = generate(cond, n, seed=s.seed, condition={condition_column: value}, dataset=dc)
+            r_plain = nearest_training_meshes(plain, n, dc, seed=s.seed)
+            r_cond = nearest_training_meshes(cond, n, dc, seed=s.seed, condition={condition_column: value})
             for tag, r in ((f"mesh VAE ({name_of(conditional_collection)})", r_plain),
                            (f"conditional, {condition_column}={value}", r_cond)):
                 table.rows.append(_row(tag, n, r, float(np.mean(r.nearest_labels[condition_column] == value))))

@@ -30,23 +30,22 @@ def interpolation_table(collection: str = "jumping", pair=None, n_steps: int = 9
     s = resolve_settings(settings, quick)
     coll = load_collection(collection, s, cache=cache)
     model = train_model(coll, s, cache)
-    ext = model.extractor_
+    kind = model.feature_kind
     F = coll.faces
-    R = np.asarray(rimd_features(ext.reference_, coll.vertices, F, layout=s.layout)).reshape(len(coll.vertices), -1)
+    R = np.asarray(rimd_features(model.reference_vertices, coll.vertices, F, layout=s.layout)).reshape(len(coll.vertices), -1)
     if pair is None:
         a = 0
         b = int(np.argmax(np.linalg.norm(R - R[a], axis=1)))
     else:
         a, b = (int(i) for i in pair)
     seqs = {}
-    encode = functools.partial(model.encode_meshes, inference="encoder")      # the paper: encoder means
-    z, seqs["latent (ours)"] = itp.interpolate_latent(encode, model.decode_latent,
-                                                       coll.vertices[a], coll.vertices[b], n_steps)
-    if ext.kind == "rimd":
-        seqs["linear RIMD"] = itp.interpolate_features(R[a], R[b], n_steps, ext.inverse_transform)
+    mu = model.encode_meshes(coll.vertices[[a, b]], inference="encoder")      # the paper: encoder means
+    z, seqs["latent (ours)"] = itp.LatentPath(model.decode_latent, mu[0], mu[1]).steps(n_steps)
+    if kind.name == "rimd":
+        seqs["linear RIMD"] = itp.interpolate_features(R[a], R[b], n_steps, kind.decode)
     seqs["linear coordinates"] = itp.interpolate_coordinates(coll.vertices[a], coll.vertices[b], n_steps)
     zg = model.sample_latent(2, seed=s.seed + 1)
-    _, seqs["latent, generated ends"] = itp.interpolate_generated(model.decode_latent, zg[0], zg[1], n_steps)
+    _, seqs["latent, generated ends"] = itp.LatentPath(model.decode_latent, zg[0], zg[1]).steps(n_steps)
     train = coll.vertices[~model.holdout_mask_]
     imp = itp.implausibility(seqs, F, train)
     table = ExperimentTable("interpolation", f"Sec. 5.3: interpolation between meshes {a} and {b} ({name_of(collection)})",

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Sequence
 
-from meshvae_lib.paper.protocol import available, heldout_error, load_collection, name_of, timed, train_model
+from meshvae_lib.model.evaluation import evaluate_model
+from meshvae_lib.paper.protocol import available, load_collection, name_of, timed, train_model
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
@@ -27,7 +28,7 @@ def latent_size_table(collections: Sequence[str] = ("jumping", "face"), latent_d
     for entry in available(collections):
         name = name_of(entry)
         coll = load_collection(entry, s, cache=cache)
-        errs = [heldout_error(train_model(coll, s, cache, latent_dim=d), coll)["mean_vertex_error"]
+        errs = [evaluate_model(train_model(coll, s, cache, latent_dim=d), coll, held_out_only=True, inference="encoder")["mean_vertex_error"]
                 for d in latent_dims]
         table.data["errors"][name] = errs
         scale, paper = PAPER["table1"].get(name, (1.0, [None] * 3))

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from meshvae_lib.paper.protocol import heldout_error, load_collection, name_of, timed, train_model
+from meshvae_lib.model.evaluation import evaluate_model
+from meshvae_lib.paper.protocol import load_collection, name_of, timed, train_model
 from meshvae_lib.paper.settings import ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
@@ -27,8 +28,8 @@ def loss_table(collection: str = "jumping", epoch_factor: int = 3, settings: Exp
     mse_model = train_model(coll, s, cache)
     epochs = mse_model.train_epochs_
     bce_model = train_model(coll, s, cache, loss="bce", epochs=epoch_factor * epochs)
-    mse_err = heldout_error(mse_model, coll)["mean_vertex_error"]
-    bce_err = heldout_error(bce_model, coll)["mean_vertex_error"]
+    mse_err = evaluate_model(mse_model, coll, held_out_only=True, inference="encoder")["mean_vertex_error"]
+    bce_err = evaluate_model(bce_model, coll, held_out_only=True, inference="encoder")["mean_vertex_error"]
     mse_hist = [h["mse"] for h in mse_model.history_]
     bce_hist = [h["mse"] for h in bce_model.history_]
     table = ExperimentTable("loss_mse_vs_bce", "MSE loss vs sigmoid + binary cross-entropy",

@@ -1,10 +1,12 @@
-"""The experiments' protocol: loading collections, the one way they train a model, the held-out error.
+"""The experiments' protocol: loading collections and the one way they train a model.
 
-A ``cache`` dict shared between experiments lets one trained model serve several tables.
-Cache keys are stable: a collection named in ``data_synth`` is keyed by its name, resolution,
-mesh count and seed; a model by the *content* of its collection (:attr:`CollectionData.fingerprint`,
-a hash of the vertices, faces and labels) and its whole training configuration. Two equal
-collections share their models, and a model is never returned for other data.
+(The held-out error of a model is :func:`~meshvae_lib.model.evaluation.evaluate_model` with
+``held_out_only=True``.) A ``cache`` dict shared between experiments lets one trained model serve
+several tables. Cache keys are stable: a collection named in ``data_synth`` is keyed by its name,
+resolution, mesh count and seed; a model by the *content* of its collection
+(:func:`collection_fingerprint`, a hash of the vertices, faces and labels) and its whole training
+configuration. Two equal collections share their models, and a model is never returned for other
+data.
 """
 
 from __future__ import annotations
@@ -14,42 +16,31 @@ import hashlib
 import json
 import logging
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvae_lib import defaults as hp
 from meshvae_lib import tolerances as tol
+from meshvae_lib.geometry.collection import MeshCollection
+from meshvae_lib.validation import check_vertices
 from meshvae_lib.paper.settings import ExperimentSettings
 
-__all__ = ["CollectionData", "load_collection", "train_model", "heldout_error", "safe_reference", "timed",
-           "name_of", "registry_names", "available"]
+__all__ = ["collection_fingerprint", "load_collection", "train_model", "safe_reference", "timed", "name_of",
+           "registry_names", "available"]
 
 logger = logging.getLogger(__name__)
 
 
-@dataclass
-class CollectionData:
-    """A collection as the experiments use it (see :func:`load_collection`)."""
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    names: list
-    labels: dict
-    description: str = ""
-    extras: dict = field(default_factory=dict)
-
-    @functools.cached_property
-    def fingerprint(self) -> str:
-        """blake2b (hex) of the vertices, the faces and the labels: what a model trained on it sees."""
-        h = hashlib.blake2b(digest_size=16)
-        for a in (np.ascontiguousarray(self.vertices, dtype=np.float64), np.ascontiguousarray(self.faces, dtype=np.int64)):
-            h.update(repr(a.shape).encode())
-            h.update(a.tobytes())
-        for k in sorted(self.labels):
-            h.update(f"\0{k}\0".encode())
-            h.update("\0".join(map(str, np.asarray(self.labels[k]).tolist())).encode())
-        return h.hexdigest()
+def collection_fingerprint(coll: MeshCollection) -> str:
+    """blake2b (hex) of a collection's vertices, faces and labels: what a model trained on it sees."""
+    h = hashlib.blake2b(digest_size=16)
+    for a in (np.ascontiguousarray(coll.vertices, dtype=np.float64), np.ascontiguousarray(coll.faces, dtype=np.int64)):
+        h.update(repr(a.shape).encode())
+        h.update(a.tobytes())
+    for k in sorted(coll.labels):
+        h.update(f"\0{k}\0".encode())
+        h.update("\0".join(map(str, np.asarray(coll.labels[k]).tolist())).encode())
+    return h.hexdigest()
 
 
 def name_of(entry) -> str:
@@ -60,15 +51,16 @@ def name_of(entry) -> str:
 
 
 def load_collection(entry, settings: ExperimentSettings | None = None, resolution=None,
-                    cache: dict | None = None) -> CollectionData:
+                    cache: dict | None = None) -> MeshCollection:
     """A collection for the experiments, thinned to ``settings.max_meshes`` (evenly spaced).
 
     entry : a ``data_synth`` collection name (made at the settings' resolution, or ``resolution``),
         a collection-like object (``vertices``, ``faces``, optional ``labels``, ``names``), or a
         callable ``resolution -> collection`` (for the density experiment with your own meshes).
 
-    Returns a :class:`CollectionData`: ``vertices (N, n, 3) float64``, ``faces (F, 3) int64``,
-    ``names``, ``labels`` (dict column -> (N,)), ``description`` and ``extras``. With ``cache``,
+    Returns a :class:`~meshvae_lib.geometry.collection.MeshCollection`: ``vertices (N, n, 3)
+    float64``, ``faces (F, 3) int64``, ``names``, ``labels`` (dict column -> (N,)), ``description``
+    and ``extras``. With ``cache``,
     names and callables are made once (a callable is kept alive by its entry, so its id cannot be
     reused while the entry lives); collection objects are thinned again each time (it is cheap).
     """
@@ -90,23 +82,21 @@ def load_collection(entry, settings: ExperimentSettings | None = None, resolutio
         c = entry(res)
     else:
         raise ValueError(f"expected a collection name, a collection or a callable, got {type(entry).__name__}")
-    V = np.asarray(c.vertices, dtype=np.float64)
-    if V.ndim != 3 or V.shape[-1] != 3:
-        raise ValueError(f"collection vertices must be (N, n_vertices, 3), got {V.shape}")
+    V = check_vertices(c.vertices, "collection vertices", batch=True)
     idx = np.arange(len(V))
     if settings.max_meshes is not None and len(V) > settings.max_meshes:
         idx = np.unique(np.round(np.linspace(0, len(V) - 1, settings.max_meshes)).astype(np.int64))
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(c, "labels", {}) or {}).items()}
     names = list(getattr(c, "names", None) or [])
     names = [names[i] for i in idx] if len(names) == len(V) else [str(i) for i in idx]
-    data = CollectionData(V[idx], np.asarray(c.faces, dtype=np.int64), names, labels, getattr(c, "description", ""),
+    data = MeshCollection(V[idx], np.asarray(c.faces, dtype=np.int64), names, labels, getattr(c, "description", ""),
                           dict(getattr(c, "extras", {}) or {}))
     if key is not None:
         cache[key] = (entry, data)
     return data
 
 
-def train_model(coll: CollectionData, settings: ExperimentSettings, cache: dict | None, *, features="rimd",
+def train_model(coll: MeshCollection, settings: ExperimentSettings, cache: dict | None, *, features=hp.DEFAULT_FEATURE_KIND,
                 latent_dim=None, sigma_object=None, labels=(), reference_index=0, holdout=True, epochs=None,
                 prior: str = "sibling", hidden=None, alpha=None, seed=None, loss: str = "mse"):
     """A MeshVAEModel trained the paper's way (from the cache when the same model was trained already).
@@ -141,7 +131,7 @@ def train_model(coll: CollectionData, settings: ExperimentSettings, cache: dict 
                       prior_form=prior, seed=settings.seed if seed is None else int(seed), device="cpu",
                       progress=False, init="random", early_stopping=False, sigma_floor=tol.SIGMA_FLOOR,
                       output="sigmoid" if loss == "bce" else "tanh", loss=loss)
-    key = ("model", coll.fingerprint, features, tuple(labels), int(reference_index), every, settings.layout,
+    key = ("model", collection_fingerprint(coll), features, tuple(labels), int(reference_index), every, settings.layout,
            json.dumps(cfg.to_dict(), sort_keys=True))
     if cache is not None and key in cache:
         return cache[key]
@@ -150,17 +140,6 @@ def train_model(coll: CollectionData, settings: ExperimentSettings, cache: dict 
     if cache is not None:
         cache[key] = model
     return model
-
-
-def heldout_error(model, coll: CollectionData, inference: str = "encoder") -> dict:
-    """:func:`~meshvae_lib.model.evaluation.evaluate_model` on the held-out meshes.
-
-    inference : "encoder" (default here: the paper's protocol encodes with the network) or the
-        library's default "gauss-newton" (codes refined on the vertex error, issue 23).
-    """
-    from meshvae_lib.model.evaluation import evaluate_model
-
-    return evaluate_model(model, coll, held_out_only=True, inference=inference)
 
 
 def safe_reference(index: int, n: int, every: int) -> int:

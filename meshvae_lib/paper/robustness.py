@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from meshvae_lib.paper.protocol import heldout_error, load_collection, name_of, safe_reference, timed, train_model
+from meshvae_lib.model.evaluation import evaluate_model
+from meshvae_lib.paper.protocol import load_collection, name_of, safe_reference, timed, train_model
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
@@ -47,7 +48,7 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     for i, (ref, res) in enumerate(runs):
         coll = load_collection(collection, s, resolution=res, cache=cache)
         r = safe_reference(ref, len(coll.vertices), s.holdout_every)
-        ev = heldout_error(train_model(coll, s, cache, reference_index=r), coll)
+        ev = evaluate_model(train_model(coll, s, cache, reference_index=r), coll, held_out_only=True, inference="encoder")
         paper = PAPER["table3"][i] if i < len(PAPER["table3"]) else (None, None, None)
         table.rows.append([f"No. {r + 1}", res, coll.vertices.shape[1], ev["mean_vertex_error"], ev["relative_error"],
                            paper[0], paper[1], None if paper[2] is None else paper[2] * 1e-4])

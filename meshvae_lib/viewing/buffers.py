@@ -13,9 +13,9 @@ import math
 import numpy as np
 
 from meshvae_lib.geometry.topology import vertex_normals
+from meshvae_lib.validation import check_faces, check_vertices
 
 __all__ = [
-    "check_vertices",
     "position_buffer",
     "normal_buffer",
     "index_buffer",
@@ -23,28 +23,6 @@ __all__ = [
     "row_offsets",
     "fit_camera",
 ]
-
-
-def check_vertices(V, name: str = "V") -> np.ndarray:
-    """Validate one mesh's positions.
-
-    Parameters
-    ----------
-    V : (n_vertices, 3) float
-        Vertex positions (any real dtype, any array-like).
-
-    Returns
-    -------
-    V : (n_vertices, 3) float64
-        A plain ndarray; raises ``ValueError`` on a wrong shape or non-finite entries.
-    """
-    V = np.asarray(V, dtype=np.float64)
-    if V.ndim != 2 or V.shape[1] != 3 or V.shape[0] == 0:
-        raise ValueError(f"{name} must have shape (n_vertices, 3) with n_vertices > 0, got {V.shape}")
-    if not np.all(np.isfinite(V)):
-        bad = int(np.count_nonzero(~np.isfinite(V).all(axis=1)))
-        raise ValueError(f"{name} has {bad} vertices with NaN or infinite coordinates")
-    return V
 
 
 def position_buffer(V) -> np.ndarray:
@@ -58,7 +36,7 @@ def position_buffer(V) -> np.ndarray:
     -------
     P : (n_vertices, 3) float32, C-contiguous
     """
-    return np.array(check_vertices(V), dtype=np.float32, order="C")
+    return np.array(check_vertices(V, "V", batch=False, finite=True), dtype=np.float32, order="C")
 
 
 def normal_buffer(V, F) -> np.ndarray:
@@ -74,7 +52,7 @@ def normal_buffer(V, F) -> np.ndarray:
     N : (n_vertices, 3) float32, C-contiguous
         Unit vectors; a vertex without faces gets the zero vector.
     """
-    return np.array(vertex_normals(check_vertices(V), F), dtype=np.float32, order="C")
+    return np.array(vertex_normals(check_vertices(V, "V", batch=False, finite=True), F), dtype=np.float32, order="C")
 
 
 def index_buffer(F, n_vertices: int) -> np.ndarray:
@@ -92,16 +70,9 @@ def index_buffer(F, n_vertices: int) -> np.ndarray:
     I : (3 * n_faces,) uint32
         ``F`` flattened row by row.
     """
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3 or F.shape[0] == 0:
+    F = check_faces(F, n_vertices=n_vertices, name="F")
+    if F.shape[0] == 0:
         raise ValueError(f"F must have shape (n_faces, 3) with n_faces > 0, got {F.shape}")
-    if not np.issubdtype(F.dtype, np.integer):
-        if not np.all(np.mod(F, 1) == 0):
-            raise ValueError(f"F must hold integer vertex indices, got dtype {F.dtype}")
-    F = F.astype(np.int64)
-    lo, hi = int(F.min()), int(F.max())
-    if lo < 0 or hi >= n_vertices:
-        raise ValueError(f"F indexes vertices {lo}..{hi} but the mesh has {n_vertices} vertices")
     return np.array(F.reshape(-1), dtype=np.uint32, order="C")
 
 
@@ -162,7 +133,7 @@ def row_offsets(meshes, gap: float = 0.25) -> np.ndarray:
     offsets : (k, 3) float64
         Add ``offsets[i]`` to mesh ``i``.
     """
-    meshes = [check_vertices(V, f"meshes[{i}]") for i, V in enumerate(meshes)]
+    meshes = [check_vertices(V, f"meshes[{i}]", batch=False, finite=True) for i, V in enumerate(meshes)]
     if not meshes:
         raise ValueError("row_offsets needs at least one mesh")
     if gap < 0:

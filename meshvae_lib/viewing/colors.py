@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvae_lib.validation import check_vertices
+
 __all__ = [
     "ColorMapping",
     "scalar_colors",
@@ -132,10 +134,7 @@ def error_colors(V_pred, V_true, vmax=None, scale: float = 1.0, cmap: str = ERRO
     errors : (n_vertices,) or (n_meshes, n_vertices) float64
         ``scale * |V_pred - V_true|`` per vertex.
     """
-    P = np.asarray(V_pred, dtype=np.float64)
-    T = np.asarray(V_true, dtype=np.float64)
-    if P.shape[-1:] != (3,) or T.shape[-1:] != (3,) or P.ndim not in (2, 3) or T.ndim not in (2, 3):
-        raise ValueError(f"V_pred and V_true must be (n_vertices, 3) or (n_meshes, n_vertices, 3), got {P.shape} and {T.shape}")
+    P, T = check_vertices(V_pred, "V_pred"), check_vertices(V_true, "V_true")
     try:
         diff = P - T
     except ValueError:

@@ -11,8 +11,9 @@ import time
 
 import numpy as np
 
-from meshvae_lib.defaults import EXPLORER_MIN_DISPLACEMENT, LIVE_UPDATE_MAX_MS
+from meshvae_lib.defaults import EXPLORATION_RANGE, EXPLORER_MIN_DISPLACEMENT, LIVE_UPDATE_MAX_MS
 from meshvae_lib.tolerances import MIN_LATENT_SPREAD
+from meshvae_lib.validation import check_choice, check_count
 from .latent_pad import LatentPad
 from .viewer import MeshViewer, as_mesh_stack
 from .widgets import _Displayable
@@ -47,8 +48,8 @@ class LatentExplorer(_Displayable):
     z0 : (latent_dim,) float, optional
         Starting point and what "reset" returns to (default zeros, the prior mean).
     value_range : (float, float) or (len(dims), 2) float
-        Slider range, shared or one row per slider (default (-3, 3): three prior standard
-        deviations).
+        Slider range, shared or one row per slider (default ``defaults.EXPLORATION_RANGE``,
+        (-2, 2): the paper's browsing range, Fig. 8).
     step : float
         Slider step.
     pad_dims : (int, int) or None
@@ -84,54 +85,59 @@ class LatentExplorer(_Displayable):
         Wall time of the last decode + normals + buffer update, in milliseconds.
     """
 
-    def __init__(self, decode, latent_dim: int, F, dims=None, z0=None, value_range=(-3.0, 3.0),
+    def __init__(self, decode, latent_dim: int, F, dims=None, z0=None, value_range=EXPLORATION_RANGE,
                  step: float = 0.05, pad_dims="auto", pad_event: str = "click", seed: int = 0,
                  random_scale=1.0, random_mean=None, reference=None, color_by=None, continuous_update="auto",
                  titles=None, **viewer_kw):
-        import ipywidgets as W
-
         self._decode = _as_decoder(decode)
-        latent_dim = int(latent_dim)
-        if latent_dim < 1:
-            raise ValueError(f"latent_dim must be >= 1, got {latent_dim}")
-        self.latent_dim = latent_dim
-        dims = list(range(min(latent_dim, 6))) if dims is None else [int(d) for d in dims]
-        if not dims or len(set(dims)) != len(dims) or min(dims) < 0 or max(dims) >= latent_dim:
-            raise ValueError(f"dims must be distinct indices in 0..{latent_dim - 1}, got {dims}")
-        self.dims = dims
-        vr = np.asarray(value_range, dtype=np.float64)
-        if vr.shape == (2,):
-            vr = np.tile(vr, (len(dims), 1))
-        if vr.shape != (len(dims), 2) or not np.all(vr[:, 1] > vr[:, 0]):
-            raise ValueError(f"value_range must be (low, high) or {len(dims)} rows of (low, high) with "
-                             f"low < high, got {np.asarray(value_range).tolist()}")
-        self.ranges = {d: (float(a), float(b)) for d, (a, b) in zip(dims, vr)}
-        z0 = np.zeros(latent_dim) if z0 is None else np.asarray(z0, dtype=np.float64).copy()
-        if z0.shape != (latent_dim,):
-            raise ValueError(f"z0 must have shape ({latent_dim},), got {z0.shape}")
+        self.latent_dim = check_count(latent_dim, "latent_dim", minimum=1)
+        self.dims = self._checked_dims(dims)
+        self.ranges = self._checked_ranges(value_range)
+        z0 = np.zeros(self.latent_dim) if z0 is None else np.asarray(z0, dtype=np.float64).copy()
+        if z0.shape != (self.latent_dim,):
+            raise ValueError(f"z0 must have shape ({self.latent_dim},), got {z0.shape}")
         self.z0 = z0
         self._z = z0.copy()
-        if color_by not in (None, "displacement"):
-            raise ValueError(f"color_by must be None or 'displacement', got {color_by!r}")
-        self.color_by = color_by
+        self.color_by = check_choice(color_by, (None, "displacement"), "color_by")
         self.seed = seed
         self._rng = np.random.default_rng(seed)
-        rs = np.asarray(random_scale, dtype=np.float64)
-        if rs.shape not in ((), (len(dims),)) or np.any(rs < 0):
-            raise ValueError(f"random_scale must be >= 0, a number or {len(dims)} numbers, got {rs.tolist()}")
-        self.random_scale = np.broadcast_to(rs, (len(dims),)).copy()
-        rm = np.zeros(latent_dim) if random_mean is None else np.asarray(random_mean, dtype=np.float64)
-        if rm.shape != (latent_dim,):
-            raise ValueError(f"random_mean must have shape ({latent_dim},), got {rm.shape}")
-        self.random_mean = rm.copy()
+        self.random_scale, self.random_mean = self._checked_random(random_scale, random_mean)
         self.n_decodes = 0
         self.last_update_ms = float("nan")
         self._suspended = False
-        if continuous_update not in (True, False, "auto"):
-            raise ValueError(f"continuous_update must be True, False or 'auto', got {continuous_update!r}")
-        self._auto_live = continuous_update == "auto"
+        self._auto_live = check_choice(continuous_update, (True, False, "auto"), "continuous_update") == "auto"
         self._recent_ms: list[float] = []
+        self.viewer = self._make_viewer(F, reference, titles, viewer_kw)
+        self._make_controls(step, continuous_update, pad_dims, pad_event)
+        self._refresh_status()
 
+    # -- construction --------------------------------------------------------------------------
+    def _checked_dims(self, dims) -> list[int]:
+        dims = list(range(min(self.latent_dim, 6))) if dims is None else [int(d) for d in dims]
+        if not dims or len(set(dims)) != len(dims) or min(dims) < 0 or max(dims) >= self.latent_dim:
+            raise ValueError(f"dims must be distinct indices in 0..{self.latent_dim - 1}, got {dims}")
+        return dims
+
+    def _checked_ranges(self, value_range) -> dict:
+        vr = np.asarray(value_range, dtype=np.float64)
+        if vr.shape == (2,):
+            vr = np.tile(vr, (len(self.dims), 1))
+        if vr.shape != (len(self.dims), 2) or not np.all(vr[:, 1] > vr[:, 0]):
+            raise ValueError(f"value_range must be (low, high) or {len(self.dims)} rows of (low, high) with "
+                             f"low < high, got {np.asarray(value_range).tolist()}")
+        return {d: (float(a), float(b)) for d, (a, b) in zip(self.dims, vr)}
+
+    def _checked_random(self, random_scale, random_mean) -> tuple[np.ndarray, np.ndarray]:
+        rs = np.asarray(random_scale, dtype=np.float64)
+        if rs.shape not in ((), (len(self.dims),)) or np.any(rs < 0):
+            raise ValueError(f"random_scale must be >= 0, a number or {len(self.dims)} numbers, got {rs.tolist()}")
+        rm = np.zeros(self.latent_dim) if random_mean is None else np.asarray(random_mean, dtype=np.float64)
+        if rm.shape != (self.latent_dim,):
+            raise ValueError(f"random_mean must have shape ({self.latent_dim},), got {rm.shape}")
+        return np.broadcast_to(rs, (len(self.dims),)).copy(), rm.copy()
+
+    def _make_viewer(self, F, reference, titles, viewer_kw) -> MeshViewer:
+        """Decode z0 and show it (after ``reference``), with the displacement colours when asked."""
         meshes = self._decode_meshes(self._z)
         self._base = meshes.copy()
         #: the least top of the displacement colour scale: a fraction of the mesh's diagonal (at the
@@ -143,16 +149,20 @@ class LatentExplorer(_Displayable):
             ref = as_mesh_stack(reference, n_meshes=1, n_vertices=meshes.shape[1])
             self._reference = ref
             meshes = np.concatenate([ref, meshes])
-        if color_by == "displacement":
+        if self.color_by == "displacement":
             viewer_kw.setdefault("values", np.zeros(meshes.shape[:2]))
             viewer_kw.setdefault("cmap", "YlOrRd")
             viewer_kw.setdefault("vmin", 0.0)
             viewer_kw.setdefault("vmax", self._displacement_floor)
             viewer_kw.setdefault("value_label", "displacement")
-        self.viewer = MeshViewer(meshes, F, titles=titles, **viewer_kw)
+        return MeshViewer(meshes, F, titles=titles, **viewer_kw)
+
+    def _make_controls(self, step, continuous_update, pad_dims, pad_event) -> None:
+        """The sliders, the reset and random buttons, the status line and the pad; ``self.widget``."""
+        import ipywidgets as W
 
         self.sliders = {}
-        for d in dims:
+        for d in self.dims:
             lo, hi = self.ranges[d]
             s = W.FloatSlider(value=float(np.clip(self._z[d], lo, hi)), min=lo, max=hi, step=step,
                               description=f"z[{d}]", continuous_update=bool(continuous_update),
@@ -160,24 +170,12 @@ class LatentExplorer(_Displayable):
             s.observe(lambda change, d=d: self._on_slider(d, change), names="value")
             self.sliders[d] = s
         self.reset_button = W.Button(description="reset", icon="undo", tooltip="back to z0")
-        self.random_button = W.Button(description="random", icon="random", tooltip=f"random draw (seed {seed})")
+        self.random_button = W.Button(description="random", icon="random", tooltip=f"random draw (seed {self.seed})")
         self.reset_button.on_click(lambda _: self.reset())
         self.random_button.on_click(lambda _: self.randomize())
         self.status = W.HTML("")
-
-        if pad_dims == "auto":
-            pad_dims = tuple(dims[:2]) if len(dims) >= 2 else None
-        self.pad = None
-        self.pad_dims = None
-        if pad_dims is not None:
-            a, b = (int(x) for x in pad_dims)
-            if a == b or a not in self.sliders or b not in self.sliders:
-                raise ValueError(f"pad_dims must be two different entries of dims {dims}, got {pad_dims}")
-            self.pad_dims = (a, b)
-            self.pad = LatentPad(self.sliders[a], self.sliders[b], event=pad_event,
-                                 use_three=self.viewer.mode == "threejs")
-            self.pad.on_pick = self._on_pad
-        others = [self.sliders[d] for d in dims if self.pad_dims is None or d not in self.pad_dims]
+        self._make_pad(pad_dims, pad_event)
+        others = [self.sliders[d] for d in self.dims if self.pad_dims is None or d not in self.pad_dims]
         controls = [W.HBox([self.reset_button, self.random_button, self.status])]
         if self.pad is not None:
             controls.append(self.pad.widget)
@@ -187,7 +185,20 @@ class LatentExplorer(_Displayable):
         self.widget.add_class("meshvae-latent-explorer")
         for d, s in self.sliders.items():
             s.add_class(f"meshvae-z{d}")
-        self._refresh_status()
+
+    def _make_pad(self, pad_dims, pad_event) -> None:
+        if pad_dims == "auto":
+            pad_dims = tuple(self.dims[:2]) if len(self.dims) >= 2 else None
+        self.pad = None
+        self.pad_dims = None
+        if pad_dims is not None:
+            a, b = (int(x) for x in pad_dims)
+            if a == b or a not in self.sliders or b not in self.sliders:
+                raise ValueError(f"pad_dims must be two different entries of dims {self.dims}, got {pad_dims}")
+            self.pad_dims = (a, b)
+            self.pad = LatentPad(self.sliders[a], self.sliders[b], event=pad_event,
+                                 use_three=self.viewer.mode == "threejs")
+            self.pad.on_pick = self._on_pad
 
     @classmethod
     def from_encodings(cls, decode, Z, F, n_dims: int = 6, spread: float = 3.0, **kw) -> "LatentExplorer":

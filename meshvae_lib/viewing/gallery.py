@@ -10,6 +10,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from meshvae_lib.validation import check_count, check_vertices
+
 __all__ = ["gallery_indices", "mesh_caption", "angular_stripes", "LABEL_UNITS"]
 
 #: label-name suffixes that hold numbers, and the unit shown after the value in a caption.
@@ -25,11 +27,10 @@ def gallery_indices(vertices, n_panels: int, groups=None) -> np.ndarray:
     distance) from the collection's first mesh -- the most deformed member -- and at most
     ``n_panels`` of them. Returns (P,) int64 indices.
     """
-    V = np.asarray(vertices, dtype=np.float64)
-    if V.ndim != 3 or V.shape[-1] != 3 or len(V) == 0:
+    V = check_vertices(vertices, "vertices", batch=True)
+    if len(V) == 0:
         raise ValueError(f"vertices must be (M, n, 3) with M >= 1, got shape {V.shape}")
-    if int(n_panels) < 1:
-        raise ValueError(f"n_panels must be >= 1, got {n_panels}")
+    n_panels = check_count(n_panels, "n_panels", minimum=1)
     if groups is None:
         return np.unique(np.linspace(0, len(V) - 1, int(n_panels)).round().astype(np.int64))
     groups = np.asarray(groups)
@@ -70,9 +71,7 @@ def angular_stripes(rest, n_stripes: int = 8, colors=((0.75, 0.8, 0.88), (0.85, 
     angle around the axis (through the centroid, in the y-z plane) falls in, so that a twist of
     the tube shows as spiralling stripes. Returns (n, 3) float64.
     """
-    rest = np.asarray(rest, dtype=np.float64)
-    if rest.ndim != 2 or rest.shape[1] != 3:
-        raise ValueError(f"rest must be (n, 3), got shape {rest.shape}")
+    rest = check_vertices(rest, "rest", batch=False)
     if int(n_stripes) < 2 or int(n_stripes) % 2:
         raise ValueError(f"n_stripes must be an even number >= 2, got {n_stripes}")
     y, z = rest[:, 1] - rest[:, 1].mean(), rest[:, 2] - rest[:, 2].mean()

@@ -18,7 +18,8 @@ from matplotlib.figure import Figure
 
 from meshvae_lib.geometry.topology import face_normals
 from meshvae_lib.tolerances import VIEW_PARALLEL_TOL
-from .buffers import check_vertices, color_buffer
+from meshvae_lib.validation import check_choice, check_count, check_faces, check_vertices
+from .buffers import color_buffer
 from .colors import DEFAULT_MESH_COLOR, ColorMapping
 
 __all__ = ["MeshFigure", "view_basis", "project", "shade", "render_mesh", "render_mesh_grid", "figure_to_png"]
@@ -56,8 +57,7 @@ def view_basis(view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
     R : (3, 3) float64
         Rows: screen right, screen up, towards the viewer.
     """
-    if up not in _UP_AXES:
-        raise ValueError(f"up must be 'y' or 'z', got {up!r}")
+    check_choice(up, tuple(_UP_AXES), "up")
     elev, azim = (math.radians(float(a)) for a in view)
     if up == "y":
         d = np.array([math.cos(elev) * math.sin(azim), math.sin(elev), math.cos(elev) * math.cos(azim)])
@@ -84,7 +84,7 @@ def project(V, view=DEFAULT_VIEW, up: str = "y") -> np.ndarray:
     P : (n_vertices, 3) float64
         Columns: screen x, screen y, depth (larger is nearer the viewer).
     """
-    return check_vertices(V) @ view_basis(view, up).T
+    return check_vertices(V, "V", batch=False, finite=True) @ view_basis(view, up).T
 
 
 def shade(normals, basis, ambient: float = 0.35, diffuse: float = 0.65) -> np.ndarray:
@@ -166,29 +166,11 @@ def render_mesh(
     """
     from matplotlib.collections import PolyCollection
 
-    V = check_vertices(V)
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
-        raise ValueError(f"F must have shape (n_faces, 3) with n_faces > 0, got {F.shape}")
-    F = F.astype(np.int64)
-    if F.min() < 0 or F.max() >= len(V):
-        raise ValueError(f"F indexes vertices {F.min()}..{F.max()} but V has {len(V)} vertices")
+    V = check_vertices(V, "V", batch=False, finite=True)
+    F = _faces(F, len(V), "F")
     R = view_basis(view, up)
     P_mesh = V @ R.T
-    base = _face_colors(colors, len(V), F)
-    if props:
-        parts_V, parts_F, parts_C, offset = [V], [F], [base], len(V)
-        for k, prop in enumerate(props):
-            if len(prop) != 3:
-                raise ValueError(f"props[{k}] must be (V, F, colour), got {len(prop)} items")
-            Vp, Fp = check_vertices(prop[0], f"props[{k}] V"), np.asarray(prop[1], dtype=np.int64)
-            if Fp.ndim != 2 or Fp.shape[1] != 3 or len(Fp) == 0 or Fp.min() < 0 or Fp.max() >= len(Vp):
-                raise ValueError(f"props[{k}] F must be (n_faces, 3) indices into its {len(Vp)} vertices")
-            parts_V.append(Vp)
-            parts_F.append(Fp + offset)
-            parts_C.append(_face_colors(prop[2], len(Vp), Fp))
-            offset += len(Vp)
-        V, F, base = np.concatenate(parts_V), np.concatenate(parts_F), np.concatenate(parts_C)
+    V, F, base = _with_props(V, F, _face_colors(colors, len(V), F), props)
     P = V @ R.T
     N = face_normals(V, F)
     rgb = np.clip(base * shade(N, R, ambient=ambient, diffuse=1.0 - ambient)[:, None], 0.0, 1.0)
@@ -207,6 +189,40 @@ def render_mesh(
         antialiaseds=True,
     )
     ax.add_collection(coll)
+    _frame(ax, P_mesh, center, extent)
+    return coll
+
+
+def _faces(F, n_vertices: int, name: str) -> np.ndarray:
+    """Triangles into ``n_vertices`` vertices, at least one: (n_faces, 3) int64."""
+    F = check_faces(F, n_vertices=n_vertices, name=name)
+    if len(F) == 0:
+        raise ValueError(f"{name} must have shape (n_faces, 3) with n_faces > 0, got {F.shape}")
+    return F
+
+
+def _with_props(V, F, base, props):
+    """The mesh and the scenery ``props`` in one set of vertices, faces and face colours."""
+    if not props:
+        return V, F, base
+    parts_V, parts_F, parts_C, offset = [V], [F], [base], len(V)
+    for k, prop in enumerate(props):
+        if len(prop) != 3:
+            raise ValueError(f"props[{k}] must be (V, F, colour), got {len(prop)} items")
+        Vp = check_vertices(prop[0], f"props[{k}] V", batch=False, finite=True)
+        try:
+            Fp = _faces(prop[1], len(Vp), f"props[{k}] F")
+        except ValueError as exc:
+            raise ValueError(f"props[{k}] F must be (n_faces, 3) indices into its {len(Vp)} vertices ({exc})") from None
+        parts_V.append(Vp)
+        parts_F.append(Fp + offset)
+        parts_C.append(_face_colors(prop[2], len(Vp), Fp))
+        offset += len(Vp)
+    return np.concatenate(parts_V), np.concatenate(parts_F), np.concatenate(parts_C)
+
+
+def _frame(ax, P_mesh, center, extent) -> None:
+    """Square limits around the projected mesh ``P_mesh`` (or ``center`` / ``extent``), no frame."""
     lo, hi = P_mesh[:, :2].min(axis=0), P_mesh[:, :2].max(axis=0)
     c = 0.5 * (lo + hi) if center is None else np.asarray(center, dtype=np.float64)
     e = 0.55 * float(np.max(hi - lo)) if extent is None else float(extent)
@@ -215,7 +231,6 @@ def render_mesh(
     ax.set_ylim(c[1] - e, c[1] + e)
     ax.set_aspect("equal")
     ax.set_axis_off()
-    return coll
 
 
 def _as_mesh_list(meshes) -> list[np.ndarray]:
@@ -223,7 +238,7 @@ def _as_mesh_list(meshes) -> list[np.ndarray]:
         meshes = [meshes]
     if isinstance(meshes, np.ndarray) and meshes.ndim != 3:
         raise ValueError(f"meshes must be (n_vertices, 3), (n_meshes, n_vertices, 3) or a list, got {meshes.shape}")
-    out = [check_vertices(V, f"meshes[{i}]") for i, V in enumerate(meshes)]
+    out = [check_vertices(V, f"meshes[{i}]", batch=False, finite=True) for i, V in enumerate(meshes)]
     if not out:
         raise ValueError("no meshes to render")
     n = {len(V) for V in out}
@@ -296,8 +311,7 @@ def render_mesh_grid(
     """
     Vs = _as_mesh_list(meshes)
     k = len(Vs)
-    if ncols < 1:
-        raise ValueError(f"ncols must be >= 1, got {ncols}")
+    check_count(ncols, "ncols", minimum=1)
     if titles is not None and len(titles) != k:
         raise ValueError(f"{len(titles)} titles for {k} meshes")
     cols = _per_mesh(colors, k, len(Vs[0]))
@@ -310,35 +324,44 @@ def render_mesh_grid(
     extent = None
     if same_scale:
         extent = 0.55 * max(float(np.max(np.ptp(V @ R[:2].T, axis=0))) for V in Vs)
-    axes = []
     for i, V in enumerate(Vs):
         ax = fig.add_subplot(nr, nc, i + 1)
         render_mesh(ax, V, F, colors=cols[i], view=view, up=up, extent=extent, **render_kw)
         if titles is not None:
             ax.set_title(str(titles[i]), fontsize=10)
-        axes.append(ax)
-    bottom = extra / (size * nr + extra + top)
-    fig.subplots_adjust(left=0.01, right=0.99, top=1.0 - top / (size * nr + extra + top) - 0.01, bottom=bottom + 0.01, wspace=0.02, hspace=0.15 if titles is not None else 0.02)
+    height = size * nr + extra + top
+    bottom = extra / height
+    fig.subplots_adjust(left=0.01, right=0.99, top=1.0 - top / height - 0.01, bottom=bottom + 0.01, wspace=0.02,
+                        hspace=0.15 if titles is not None else 0.02)
     if colorbar is not None:
-        from matplotlib.cm import ScalarMappable
-        from matplotlib.colors import Normalize
-
-        import matplotlib
-
-        cax = fig.add_axes([0.25, 0.62 * bottom, 0.5, 0.2 * bottom])
-        sm = ScalarMappable(norm=Normalize(colorbar.vmin, colorbar.vmax), cmap=matplotlib.colormaps[colorbar.cmap])
-        cb = fig.colorbar(sm, cax=cax, orientation="horizontal")
-        cb.ax.tick_params(labelsize=8)
-        if colorbar.label:
-            cb.set_label(colorbar.label, fontsize=9)
+        _add_colorbar(fig, colorbar, bottom)
     if legend:
-        from matplotlib.patches import Patch
-
-        handles = [Patch(facecolor=c, edgecolor="#666", label=str(n)) for n, c in legend]
-        fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
+        _add_legend(fig, legend)
     if suptitle:
         fig.suptitle(suptitle)
     return fig
+
+
+def _add_legend(fig, legend) -> None:
+    """Swatches of ``legend`` (a list of (name, colour)) under the grid."""
+    from matplotlib.patches import Patch
+
+    handles = [Patch(facecolor=c, edgecolor="#666", label=str(n)) for n, c in legend]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
+
+
+def _add_colorbar(fig, colorbar: ColorMapping, bottom: float) -> None:
+    """A horizontal colour bar of ``colorbar`` in the figure's bottom margin (``bottom``: its height)."""
+    import matplotlib
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    cax = fig.add_axes([0.25, 0.62 * bottom, 0.5, 0.2 * bottom])
+    sm = ScalarMappable(norm=Normalize(colorbar.vmin, colorbar.vmax), cmap=matplotlib.colormaps[colorbar.cmap])
+    cb = fig.colorbar(sm, cax=cax, orientation="horizontal")
+    cb.ax.tick_params(labelsize=8)
+    if colorbar.label:
+        cb.set_label(colorbar.label, fontsize=9)
 
 
 def figure_to_png(fig, dpi=None) -> bytes:

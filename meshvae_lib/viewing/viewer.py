@@ -16,7 +16,8 @@ import time
 import numpy as np
 
 from meshvae_lib.geometry.topology import vertex_normals
-from .buffers import check_vertices, color_buffer, fit_camera, index_buffer, position_buffer, row_offsets
+from meshvae_lib.validation import check_vertices
+from .buffers import color_buffer, fit_camera, index_buffer, position_buffer, row_offsets
 from .colors import DEFAULT_MESH_COLOR, ColorMapping, colorbar_html, label_colors, legend_html, scalar_colors
 from .fallback import ImageView, resolve_mode
 
@@ -41,7 +42,7 @@ def as_mesh_stack(V, n_meshes: int | None = None, n_vertices: int | None = None)
     if isinstance(V, (list, tuple)):
         if not V:
             raise ValueError("no meshes given")
-        arrs = [check_vertices(v, f"V[{i}]") for i, v in enumerate(V)]
+        arrs = [check_vertices(v, f"V[{i}]", batch=False, finite=True) for i, v in enumerate(V)]
         counts = {len(a) for a in arrs}
         if len(counts) != 1:
             raise ValueError(f"all meshes must have the same vertex count, got {sorted(counts)}")
@@ -49,7 +50,7 @@ def as_mesh_stack(V, n_meshes: int | None = None, n_vertices: int | None = None)
     else:
         Vs = np.asarray(V, dtype=np.float64)
         if Vs.ndim == 2:
-            Vs = check_vertices(Vs)[None]
+            Vs = check_vertices(Vs, "V", batch=False, finite=True)[None]
         elif Vs.ndim != 3 or Vs.shape[2] != 3 or 0 in Vs.shape:
             raise ValueError(f"V must be (n_vertices, 3), (n_meshes, n_vertices, 3) or a list, got {Vs.shape}")
         elif not np.all(np.isfinite(Vs)):

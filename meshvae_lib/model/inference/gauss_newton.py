@@ -1,25 +1,18 @@
-"""Latent inference: which code z a trained mesh VAE gives a mesh.
-
-Three strategies, by name (``defaults.INFERENCE_METHODS``; ``MeshVAEModel(inference=...)`` picks
-the model's default, ``encode_meshes(..., inference=...)`` one call's):
-
-- ``"encoder"``: the paper's amortised inference, the encoder's mean ``mu(x)`` of the mesh's
-  normalised features. One matrix product; on real collections it spends its code on feature
-  directions that barely move the vertices (docs/vae.md, "Why the encoder falls short").
-- ``"gauss-newton"`` (default): semi-amortised inference. Start at the encoder's mean, then take
-  a few damped Gauss-Newton (Levenberg-Marquardt) steps on the decoded mesh's squared vertex
-  error, ``min_z min_(R,t) sum_k |decode(z)_k - (R x_k + t)|^2``, with the **analytic** Jacobian
-  of decoder and reconstruction: :func:`decoder_jacobian` (the network, then the affine maps of
-  the output range and Eq. 3) times the feature kind's linearisation
-  (:meth:`FeatureExtractor.linearize`, for RIMD
-  :mod:`~meshvae_lib.geometry.reconstruction_linearization`). One step costs one Jacobian (two
-  factorised sparse solves per latent dimension) and usually one decode.
-- ``"finite-difference"``: the same objective with undamped steps and a Jacobian by forward
-  differences (D + 1 decodes per step; ``MeshVAEModel.fit_latent``). Kept as a reference.
+"""Semi-amortised inference (the default): the encoder's mean, then a few damped Gauss-Newton
+(Levenberg-Marquardt) steps on the decoded mesh's squared vertex error,
+``min_z min_(R,t) sum_k |decode(z)_k - (R x_k + t)|^2``, with the **analytic** Jacobian of decoder
+and reconstruction: :func:`decoder_jacobian` (the network, then the affine maps of the output range
+and Eq. 3) times the feature kind's linearisation (``FeatureKind.linearize``; for RIMD
+:mod:`~meshvae_lib.geometry.reconstruction_linearization`). One step costs one Jacobian (two
+factorised sparse solves per latent dimension) and usually one decode. On real collections the
+encoder alone spends its code on feature directions that barely move the vertices (docs/vae.md,
+"Why the encoder falls short"); this fixes that without changing the model.
 
 The rigid motion is eliminated by projecting the six rigid vertex fields (three translations,
 three rotations about the centroid) out of the Jacobian and aligning the target to each decoded
-mesh; the model's decoder, normaliser and reconstruction are not changed.
+mesh; the model's decoder, normaliser and reconstruction are not changed. The analytic Jacobian
+reads the output layer of :class:`~meshvae_lib.model.vae.MeshVAE` (``decoder_head``, and
+``decoder_body`` with internal layers).
 """
 
 from __future__ import annotations
@@ -29,9 +22,11 @@ import torch
 
 from meshvae_lib import tolerances as tol
 from meshvae_lib.geometry.alignment import rigid_align
-from meshvae_lib.model.training import from_output_range
+from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
+from meshvae_lib.model.inference.base import InferenceStrategy
+from meshvae_lib.validation import check_count
 
-__all__ = ["decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes"]
+__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes"]
 
 
 def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -138,16 +133,12 @@ class _Decoder:
     """Codes -> features and their Jacobian for one model, with the network's weights converted once."""
 
     def __init__(self, model, conditions: np.ndarray | None):
-        net = model.network_
-        self.model, self.network, self.conditions = model, net, conditions
+        net = model.network
+        self.kind, self.network, self.conditions = model.feature_kind, net, conditions
         K, D = net.n_features, net.latent_dim
-
-        def to_features(r):
-            return model.normalizer_.inverse_transform(from_output_range(r, model.normalizer_.a, net.output))
-
         # rows -> features is affine per column (the output range, then Eq. 3 inverted)
-        self.offset = np.asarray(to_features(np.zeros((1, K))), dtype=np.float64)[0]
-        self.scale = np.asarray(to_features(np.ones((1, K))), dtype=np.float64)[0] - self.offset
+        self.offset = np.asarray(model.features_from_rows(np.zeros((1, K))), dtype=np.float64)[0]
+        self.scale = np.asarray(model.features_from_rows(np.ones((1, K))), dtype=np.float64)[0] - self.offset
         if net.hidden:
             self.used = np.arange(D)
             return
@@ -186,7 +177,7 @@ class _DecodedState:
     def __init__(self, decoder: _Decoder, features: np.ndarray, slope, x: np.ndarray):
         self.slope = slope
         self.network_jacobian = getattr(decoder, "_J", None)
-        self.lin = decoder.model.extractor_.linearize(features)
+        self.lin = decoder.kind.linearize(features)
         P = self.lin.positions
         self.residual = rigid_align(x, P) - P                      # (n, 3): target moved onto P
         self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
@@ -196,7 +187,7 @@ class _DecodedState:
 
 
 def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: np.ndarray | None = None,
-                       iterations: int = 4, progress: bool = False) -> tuple[np.ndarray, GaussNewtonReport]:
+                       iterations: int = GAUSS_NEWTON_ITERATIONS, progress: bool = False) -> tuple[np.ndarray, GaussNewtonReport]:
     """Codes fitted to vertex positions by damped Gauss-Newton with the analytic Jacobian.
 
     Parameters
@@ -265,3 +256,37 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
                 break
         report.final_error[j] = state.mean_error
     return Z, report
+
+
+class GaussNewton(InferenceStrategy):
+    """The encoder's mean refined by damped Gauss-Newton steps on the vertex error
+    (:func:`gauss_newton_codes`; the module docstring). Never worse than the encoder's mean.
+
+    Parameters
+    ----------
+    iterations : Jacobians per mesh at most (>= 1).
+
+    Attributes
+    ----------
+    report_ : :class:`GaussNewtonReport` of the latest :meth:`infer` (errors before and after,
+        steps and decodes per mesh), None before.
+    """
+
+    name = "gauss-newton"
+    options = ("iterations",)
+
+    def __init__(self, iterations: int = GAUSS_NEWTON_ITERATIONS):
+        self.iterations = check_count(iterations, "iterations", minimum=1)
+        self.report_ = None
+
+    def describe(self) -> str:
+        return f"encoder + Gauss-Newton, {self.iterations} steps"
+
+    def infer(self, model, vertices: np.ndarray, conditions: np.ndarray | None, progress: bool = False) -> np.ndarray:
+        if not hasattr(model.network, "decoder_head"):
+            raise ValueError(f"the gauss-newton inference needs the analytic Jacobian of a mesh-vae network; this one is"
+                             f" {model.network.architecture!r}: use inference='finite-difference' or 'encoder'")
+        mu, _ = model.encode_rows(model.features_of(vertices), conditions)
+        c = None if conditions is None else np.asarray(conditions, dtype=np.float64)
+        Z, self.report_ = gauss_newton_codes(model, vertices, mu, c, iterations=self.iterations, progress=progress)
+        return Z

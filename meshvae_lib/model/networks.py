@@ -1,0 +1,82 @@
+"""Networks: what the estimator, the trainer and the checkpoint need of one, and the registry of
+architectures.
+
+A network is a ``torch.nn.Module`` that follows :class:`Network`: the four steps of a VAE
+(``encode``, ``reparameterize``, ``decode``, ``forward``), its sizes, the activation its decoder
+ends in, the latent dimensions its decoder reads, and a ``config()`` from which ``from_config``
+rebuilds it; ``start`` makes a new one to train. :data:`ARCHITECTURES` maps each architecture's
+name (the network's ``architecture`` attribute, recorded in checkpoints) to its class.
+
+To add an architecture: write a module with a class that follows :class:`Network` and add one
+line to :data:`ARCHITECTURES`; ``TrainConfig(architecture=...)`` trains it, and the checkpoint
+stores and rebuilds it by name.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+if TYPE_CHECKING:  # pragma: no cover
+    import numpy as np
+    import torch
+
+__all__ = ["Network", "ARCHITECTURES", "network_class", "start_network", "network_from_config"]
+
+#: architecture name -> "module:Class" of a network that follows :class:`Network`.
+ARCHITECTURES = {
+    "mesh-vae": "meshvae_lib.model.vae:MeshVAE",
+}
+
+
+@runtime_checkable
+class Network(Protocol):
+    """What the library needs of a network (a ``torch.nn.Module``).
+
+    x : (B, K) float32 normalised feature rows; c : (B, C) float32 condition vectors or None;
+    z, mu, sigma : (B, D) float32.
+    """
+
+    architecture: str  # its key in ARCHITECTURES
+    n_features: int  # K
+    latent_dim: int  # D
+    n_conditions: int  # C (0: unconditional)
+    output: str  # the decoder's last activation, "tanh" (rows in (-1, 1)) or "sigmoid" ((0, 1))
+
+    def encode(self, x: "torch.Tensor", c: "torch.Tensor | None" = None) -> "tuple[torch.Tensor, torch.Tensor]":
+        """q(z | x, c): (mu, sigma)."""
+
+    def reparameterize(self, mu, sigma, generator=None) -> "torch.Tensor":
+        """A draw z = mu + sigma * eps."""
+
+    def decode(self, z: "torch.Tensor", c: "torch.Tensor | None" = None) -> "torch.Tensor":
+        """The decoder's mean: rows (B, K)."""
+
+    def forward(self, x, c=None, generator=None) -> "tuple[torch.Tensor, torch.Tensor, torch.Tensor]":
+        """(decode(reparameterize(encode(x, c)), c), mu, sigma)."""
+
+    def config(self) -> dict:
+        """Everything ``from_config`` needs to rebuild the network (plain numbers, strings, lists)."""
+
+    def used_latent_dims(self) -> "np.ndarray":
+        """Indices of the latent dimensions the decoder reads (all of them unless it knows better)."""
+
+
+def network_class(architecture: str) -> type:
+    """The class registered as ``architecture``; ValueError naming the architectures for an unknown one."""
+    if architecture not in ARCHITECTURES:
+        raise ValueError(f"architecture must be one of {tuple(ARCHITECTURES)}, got {architecture!r}")
+    module, _, attr = ARCHITECTURES[architecture].partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+def start_network(architecture: str, x, n_conditions: int, config) -> Network:
+    """A new network of ``architecture`` to train on rows ``x (N, K)`` float32 with ``n_conditions``
+    condition inputs and the :class:`~meshvae_lib.model.train_config.TrainConfig` ``config`` (the
+    caller seeds torch's generator)."""
+    return network_class(architecture).start(x, n_conditions, config)
+
+
+def network_from_config(architecture: str, config: dict) -> Network:
+    """The network of ``architecture`` that ``config`` (its ``config()``) describes, weights untrained."""
+    return network_class(architecture).from_config(dict(config))
