@@ -105,6 +105,13 @@ EXPLORER_MIN_DISPLACEMENT = 0.01
 #: a latent slider decodes while it is dragged as long as one update (decode + normals + buffers)
 #: takes less than this many milliseconds; slower models switch to decoding on release.
 LIVE_UPDATE_MAX_MS = 150.0
+#: what a page without a widget front end (a static notebook page, a PDF) shows of a FramePlayer:
+#: this many evenly spaced frames in a strip; of a LatentExplorer: its first this-many dimensions,
+#: each at the low end, the start and the high end of its slider; panels this many inches, at this dpi.
+STATIC_STRIP_FRAMES = 6
+STATIC_GRID_DIMS = 4
+STATIC_PANEL_INCHES = 2.2
+STATIC_DPI = 90
 #: a progress bar (meshvae_lib.progress) whose stream is not a terminal -- a CI log, a pipe --
 #: redraws at most every this many seconds (in a terminal or a notebook: tqdm's 0.1 s).
 PROGRESS_LOG_SECONDS = 10.0

@@ -35,3 +35,14 @@ def test_bad_input_says_what_is_wrong():
         first_argmax([1.0, np.nan])
     with pytest.raises(ValueError, match="rtol must be >= 0, got -1"):
         first_argmax([1.0], rtol=-1)
+
+
+def test_real_inference_table_prints_the_recorded_rows_and_their_ratio():
+    from meshvae_lib.course.display import real_inference_table
+
+    rows = [{"collection": "a/3", "paper_path": 0.5, "encoder": 0.25, "default": 0.01, "pca_coords": 0.04},
+            {"collection": "b", "paper_path": None, "encoder": 1.0, "default": 3.0, "pca_coords": 1.5}]
+    lines = real_inference_table(rows).splitlines()
+    assert len(lines) == 3 and lines[0].split()[:2] == ["collection", "paper"]
+    assert lines[1].split() == ["a/3", "5.00e-01", "2.50e-01", "1.00e-02", "4.00e-02", "0.25"]
+    assert lines[2].split() == ["b", "-", "1.00e+00", "3.00e+00", "1.50e+00", "2.00"]

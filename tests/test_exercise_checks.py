@@ -90,6 +90,12 @@ WRONG_ANSWERS = {
         "only the four dimensions of section 4 swept": (
             "strength = np.r_[np.abs(effects.effect).max(axis=1), np.zeros(LATENT - 4)]\n"),
     },
+    ("09_evaluation", 1): {
+        "the floor copied from the table": (
+            "pca_err = rows['jumping']['ours aligned']\n"
+            "rimd_over_pca = rows['jumping']['ours rimd'] / pca_err\n"),
+        "a floor of zero": "pca_err = 0.0\nrimd_over_pca = float('inf')\n",
+    },
     ("10_bring_your_own", 1): {
         "any three meshes of the data": (
             "column = next(iter(coll.labels))\n"

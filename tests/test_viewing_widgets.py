@@ -286,3 +286,41 @@ def test_per_slider_ranges_are_validated(sphere):
         LatentExplorer(dec, 3, F, dims=[0, 1], value_range=[[-1, 1], [2, 2]], mode="threejs")
     with pytest.raises(ValueError, match="random_scale"):
         LatentExplorer(dec, 3, F, dims=[0, 1], random_scale=[1.0, 2.0, 3.0], mode="threejs")
+
+
+# -- what a page without widgets shows ----------------------------------------------------------
+def _png_size(png: bytes) -> tuple[int, int]:
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")   # IHDR width, height
+
+
+def test_a_static_page_shows_a_strip_of_the_players_frames(sphere, monkeypatch):
+    from meshvae_lib.viewing import render
+
+    V, F = sphere
+    frames = np.stack([V * s for s in np.linspace(1.0, 2.0, 11)])
+    p = FramePlayer([frames, frames + 0.1], F, titles=["a", "b"], mode="threejs")
+    shown = []
+    real = render.render_mesh_grid
+    monkeypatch.setattr(render, "render_mesh_grid", lambda meshes, *a, **kw: shown.append((meshes, kw)) or real(meshes, *a, **kw))
+    png = p._repr_mimebundle_()["image/png"]
+    meshes, kw = shown[0]
+    assert kw["titles"][:6] == ["a frame 0", "a frame 2", "a frame 4", "a frame 6", "a frame 8", "a frame 10"]
+    np.testing.assert_array_equal(meshes[5], frames[10])            # first and last frames included
+    np.testing.assert_array_equal(meshes[6], frames[0] + 0.1)       # one row per sequence
+    w, h = _png_size(png)
+    assert w >= 6 * 150 and h > w / 6, f"a readable strip of six panels, got {w}x{h} px"
+    assert p.frame == 0 and len(FramePlayer(frames[:2], F, mode="threejs")._static_frames()) == 2
+
+
+def test_a_static_page_shows_the_explorers_slider_extremes(sphere):
+    V, F = sphere
+    dec = LinearDecoder(V, 5)
+    ex = LatentExplorer(dec, 5, F, dims=[0, 1, 2, 3, 4], value_range=(-2, 2), mode="threejs")
+    before, n_calls = ex.n_decodes, len(dec.calls)
+    w, h = _png_size(ex._repr_mimebundle_()["image/png"])
+    zs = np.array(dec.calls[n_calls:])
+    assert len(zs) == 12 and ex.n_decodes == before             # 4 dimensions x (low, start, high); no slider moved
+    np.testing.assert_array_equal(zs[:3, 0], [-2.0, 0.0, 2.0])
+    assert np.count_nonzero(zs[:3, 1:]) == 0 and zs[11, 3] == 2.0
+    assert w >= 3 * 150 and h >= 4 * 150, f"a 4 x 3 grid of readable panels, got {w}x{h} px"

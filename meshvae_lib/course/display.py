@@ -11,7 +11,7 @@ import numpy as np
 
 from meshvae_lib.tolerances import TIE_RTOL
 
-__all__ = ["roundoff", "first_argmax"]
+__all__ = ["roundoff", "first_argmax", "real_inference_table"]
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -45,3 +45,16 @@ def first_argmax(values, rtol: float = TIE_RTOL) -> int:
         raise ValueError(f"rtol must be >= 0, got {rtol}")
     top = x.max()
     return int(np.flatnonzero(x >= top - rtol * abs(top))[0])
+
+
+def real_inference_table(rows) -> str:
+    """The recorded real-mesh comparison (``docs/results/inference_real.json``'s ``rows``: dicts with
+    ``collection``, ``paper_path`` (or None), ``encoder``, ``default``, ``pca_coords``) as a
+    fixed-width table: held-out errors of the paper's path, the encoder, the default inference and
+    PCA on coordinates, and default / PCA. Recorded numbers, the same on every machine."""
+    lines = [f"{'collection':10s} {'paper path':>10s} {'encoder':>9s} {'default':>9s} {'PCA coords':>10s} {'default / PCA':>13s}"]
+    for r in rows:
+        paper_path = "-" if r.get("paper_path") is None else f"{r['paper_path']:.2e}"
+        lines.append(f"{r['collection']:10s} {paper_path:>10s} {r['encoder']:9.2e} {r['default']:9.2e}"
+                     f" {r['pca_coords']:10.2e} {r['default'] / r['pca_coords']:13.2f}")
+    return "\n".join(lines)

@@ -11,7 +11,8 @@ import time
 
 import numpy as np
 
-from meshvae_lib.defaults import EXPLORATION_RANGE, EXPLORER_MIN_DISPLACEMENT, LIVE_UPDATE_MAX_MS
+from meshvae_lib.defaults import (EXPLORATION_RANGE, EXPLORER_MIN_DISPLACEMENT, LIVE_UPDATE_MAX_MS, STATIC_DPI,
+                                  STATIC_GRID_DIMS, STATIC_PANEL_INCHES)
 from meshvae_lib.tolerances import MIN_LATENT_SPREAD
 from meshvae_lib.validation import check_choice, check_count
 from .latent_pad import LatentPad
@@ -244,6 +245,23 @@ class LatentExplorer(_Displayable):
         kw.setdefault("random_scale", std[dims])
         kw.setdefault("step", float(np.min(half)) / 50.0)
         return cls(decode, Z.shape[1], F, dims=dims, value_range=ranges, **kw)
+
+    def static_png(self) -> bytes:
+        """What a static page shows of the explorer (PNG ``bytes``): for each of the first
+        ``STATIC_GRID_DIMS`` dimensions a row of three meshes, that dimension at the low end of its
+        slider, at the start ``z0`` and at the high end (the others at ``z0``)."""
+        from .render import figure_to_png, render_mesh_grid
+
+        meshes, titles, count = [], [], self.n_decodes
+        for d in self.dims[:STATIC_GRID_DIMS]:
+            for v in (self.ranges[d][0], self.z0[d], self.ranges[d][1]):
+                z = self.z0.copy()
+                z[d] = v
+                meshes.append(self._decode_meshes(z)[0])
+                titles.append(f"z[{d}] = {v:+.1f}")
+        self.n_decodes = count                      # a picture, not a slider move
+        return figure_to_png(render_mesh_grid(meshes, self.viewer.F, titles=titles, ncols=3,
+                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
 
     # -- decoding ------------------------------------------------------------------------------
     def _decode_meshes(self, z) -> np.ndarray:

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvae_lib.defaults import STATIC_DPI, STATIC_PANEL_INCHES, STATIC_STRIP_FRAMES
+
 from .viewer import MeshViewer, as_mesh_stack
 
 __all__ = ["FramePlayer", "InterpolationSlider"]
@@ -33,8 +35,13 @@ class _Displayable:
         data = self.widget._repr_mimebundle_()
         data["text/plain"] = repr(self)
         if self.viewer.mode == "threejs" and self.viewer.snapshot:
-            data["image/png"] = self.viewer.snapshot_png()
+            data["image/png"] = self.static_png()
         return data
+
+    def static_png(self) -> bytes:
+        """What a page without a widget front end shows (PNG ``bytes``): the view's current state,
+        unless the widget says more in a picture (a player's strip, an explorer's grid)."""
+        return self.viewer.snapshot_png()
 
     def _ipython_display_(self):
         from IPython.display import display
@@ -146,6 +153,23 @@ class FramePlayer(_Displayable):
         """Advance by ``k`` frames (wrapping around); returns the new frame index."""
         self.frame = (self.frame + int(k)) % self.n_frames
         return self.frame
+
+    def static_png(self) -> bytes:
+        """A strip of ``STATIC_STRIP_FRAMES`` evenly spaced frames (first and last included), one row
+        per sequence, shaded: what a static page shows of the player (PNG ``bytes``)."""
+        from .render import figure_to_png, render_mesh_grid
+
+        idx = self._static_frames()
+        n_seq = self._frames.shape[1]
+        names = self.viewer.titles or [""] * n_seq
+        meshes = [self._frames[i, s] for s in range(n_seq) for i in idx]
+        titles = [f"{names[s]} frame {i}".strip() for s in range(n_seq) for i in idx]
+        return figure_to_png(render_mesh_grid(meshes, self.viewer.F, titles=titles, ncols=len(idx),
+                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
+
+    def _static_frames(self) -> np.ndarray:
+        """The strip's frame indices: ``STATIC_STRIP_FRAMES`` evenly spaced, first and last included."""
+        return np.unique(np.linspace(0, self.n_frames - 1, min(self.n_frames, STATIC_STRIP_FRAMES)).round().astype(int))
 
     def __repr__(self) -> str:
         return f"FramePlayer({self.n_frames} frames, {self.viewer.n_meshes} sequence(s), mode={self.viewer.mode!r})"
