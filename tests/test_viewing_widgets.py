@@ -324,3 +324,13 @@ def test_a_static_page_shows_the_explorers_slider_extremes(sphere):
     np.testing.assert_array_equal(zs[:3, 0], [-2.0, 0.0, 2.0])
     assert np.count_nonzero(zs[:3, 1:]) == 0 and zs[11, 3] == 2.0
     assert w >= 3 * 150 and h >= 4 * 150, f"a 4 x 3 grid of readable panels, got {w}x{h} px"
+
+
+def test_a_static_page_shows_the_interpolation_along_t(sphere):
+    V, F = sphere
+    seen = []
+    s = InterpolationSlider(V, 2 * V, F, interpolate=lambda t: seen.append(t) or (1 + t) * V, mode="threejs")
+    seen.clear()
+    w, h = _png_size(s._repr_mimebundle_()["image/png"])
+    np.testing.assert_allclose(seen, np.linspace(0.0, 1.0, 6))      # both ends included
+    assert s.t == 0.0 and w >= 6 * 150, f"a readable strip, got {w}x{h} px"

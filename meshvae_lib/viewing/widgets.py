@@ -235,5 +235,15 @@ class InterpolationSlider(_Displayable):
             raise ValueError(f"t must be in [0, 1], got {value}")
         self.slider.value = float(value)
 
+    def static_png(self) -> bytes:
+        """A strip of ``STATIC_STRIP_FRAMES`` meshes along the path, ``t`` evenly spaced from 0 to 1
+        (the ends included): what a static page shows of the slider (PNG ``bytes``)."""
+        from .render import figure_to_png, render_mesh_grid
+
+        ts = np.linspace(0.0, 1.0, STATIC_STRIP_FRAMES)
+        return figure_to_png(render_mesh_grid([self.mesh_at(t) for t in ts], self.viewer.F,
+                                              titles=[f"t = {t:.1f}" for t in ts], ncols=len(ts),
+                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
+
     def __repr__(self) -> str:
         return f"InterpolationSlider({self.viewer.n_vertices} vertices, mode={self.viewer.mode!r})"
