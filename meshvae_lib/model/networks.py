@@ -14,8 +14,9 @@ stores and rebuilds it by name.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+from meshvae_lib.model.registry import registered_class
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -64,10 +65,7 @@ class Network(Protocol):
 
 def network_class(architecture: str) -> type:
     """The class registered as ``architecture``; ValueError naming the architectures for an unknown one."""
-    if architecture not in ARCHITECTURES:
-        raise ValueError(f"architecture must be one of {tuple(ARCHITECTURES)}, got {architecture!r}")
-    module, _, attr = ARCHITECTURES[architecture].partition(":")
-    return getattr(importlib.import_module(module), attr)
+    return registered_class(ARCHITECTURES, architecture, "architecture")
 
 
 def start_network(architecture: str, x, n_conditions: int, config) -> Network:

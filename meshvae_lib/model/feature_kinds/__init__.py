@@ -14,7 +14,7 @@ command line's ``--features`` and the paper's Table 2 then take it by name.
 
 from __future__ import annotations
 
-import importlib
+from meshvae_lib.model.registry import registered_class
 
 __all__ = ["KINDS", "FEATURE_KINDS", "kind_class", "make_kind", "kind_from_state"]
 
@@ -30,10 +30,7 @@ FEATURE_KINDS = tuple(KINDS)
 
 def kind_class(name: str) -> type:
     """The class registered as ``name``; ValueError naming the kinds for an unknown one."""
-    if name not in KINDS:
-        raise ValueError(f"feature kind must be one of {tuple(KINDS)}, got {name!r}")
-    module, _, attr = KINDS[name].partition(":")
-    return getattr(importlib.import_module(module), attr)
+    return registered_class(KINDS, name, "feature kind")
 
 
 def make_kind(name: str, reference, faces, **options):

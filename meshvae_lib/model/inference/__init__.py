@@ -18,7 +18,7 @@ To add a strategy: write a module with an :class:`InferenceStrategy` subclass (`
 
 from __future__ import annotations
 
-import importlib
+from meshvae_lib.model.registry import registered_class
 
 __all__ = ["METHODS", "INFERENCE_METHODS", "inference_class", "make_inference"]
 
@@ -34,10 +34,7 @@ INFERENCE_METHODS = tuple(METHODS)
 
 def inference_class(name: str) -> type:
     """The class registered as ``name``; ValueError naming the methods for an unknown one."""
-    if name not in METHODS:
-        raise ValueError(f"inference must be one of {tuple(METHODS)}, got {name!r}")
-    module, _, attr = METHODS[name].partition(":")
-    return getattr(importlib.import_module(module), attr)
+    return registered_class(METHODS, name, "inference")
 
 
 def make_inference(spec, **options):
