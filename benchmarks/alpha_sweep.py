@@ -12,6 +12,10 @@ Eq. 4 implies for the trained decoder (``posterior.decoder_sigma``: the closed f
     python benchmarks/alpha_sweep.py                                   # the recorded run (about 20 min)
     python benchmarks/alpha_sweep.py --alphas 1e3 --seeds 0,1 --epochs 200
     python benchmarks/alpha_sweep.py --out docs/results                # writes alpha_sweep.json / .md
+
+The recorded run (docs/results) used notebook 04's recording setting, so that its seed-0 runs are
+the notebook's own: ``env OPENBLAS_CORETYPE=Haswell NPY_DISABLE_CPU_FEATURES=X86_V4,AVX512_ICL,AVX512_SPR
+python benchmarks/alpha_sweep.py --threads 2 --out docs/results``.
 """
 
 from __future__ import annotations
@@ -101,7 +105,8 @@ def provenance(args) -> dict:
     return {"commit": git("rev-parse", "HEAD"), "uncommitted_changes": bool(git("status", "--porcelain", "--untracked-files=no")),
             "versions": {"python": platform.python_version(), "numpy": np.__version__, "torch": torch.__version__},
             "machine": {"cpu": cpu, "cores": os.cpu_count(), "torch_threads": args.threads,
-                        "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE")}}
+                        "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
+                        "npy_disable_cpu_features": os.environ.get("NPY_DISABLE_CPU_FEATURES")}}
 
 
 def main(argv=None) -> int:
@@ -113,7 +118,7 @@ def main(argv=None) -> int:
     ap.add_argument("--alphas", default="1e6,1e4,1e3,1e2")
     ap.add_argument("--seeds", default="0,1,2,3,4")
     ap.add_argument("--epochs", default="200,1000")
-    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--threads", type=int, default=2, help="torch threads (notebook 04 uses 2)")
     ap.add_argument("--out", default=None, metavar="DIR", help="write alpha_sweep.json and alpha_sweep.md there")
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
