@@ -90,6 +90,25 @@ def test_edge_length_distortion_rigid_invariance_and_scale(rng):
         itp.edge_length_distortion(V, F, V)
 
 
+def test_vertex_edge_stretch_against_a_loop_and_in_closed_form(rng):
+    V, F = grid(3, 4)
+    Vd = V[None] + 0.1 * rng.normal(size=(2, len(V), 3))
+    got = itp.vertex_edge_stretch(Vd, V, F)
+    E = edges(F)
+    for k in range(2):
+        for v in range(len(V)):                      # the definition, one vertex at a time
+            at = [e for e in range(len(E)) if v in E[e]]
+            ref = np.mean([abs(np.linalg.norm(Vd[k, E[e, 0]] - Vd[k, E[e, 1]]) / np.linalg.norm(V[E[e, 0]] - V[E[e, 1]]) - 1)
+                           for e in at])
+            assert got[k, v] == pytest.approx(ref, rel=1e-12)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    assert np.abs(itp.vertex_edge_stretch(V @ Q.T + 2.0, V, F)).max() < 1e-12       # rigid: zero
+    assert np.allclose(itp.vertex_edge_stretch(0.7 * V, V, F), 0.3, atol=1e-12)     # scale c: |c - 1|
+    assert itp.vertex_edge_stretch(Vd[0], V, F).shape == (len(V),)
+    with pytest.raises(ValueError, match="V_ref"):
+        itp.vertex_edge_stretch(Vd, Vd, F)
+
+
 def test_batch_and_implausibility_table(rng):
     V, F = grid(3, 3)
     seq = {"a": np.stack([V, V * 1.1]), "b": np.stack([V, V])}

@@ -17,6 +17,8 @@ Implausibility, to put numbers beside the pictures (``implausibility`` tabulates
 - ``edge_length_distortion(V, F, dataset)``: the mean relative edge-length change against the
   data-set mesh that is nearest by this same measure (it is rigid-motion invariant). An
   interpolation that stays on the shape space keeps edges close to those of some real mesh.
+- ``vertex_edge_stretch(V, V_ref, F)``: the same change against one given mesh, per vertex (the
+  mean over its edges), to colour a mesh by where it stretches.
 """
 
 from __future__ import annotations
@@ -25,10 +27,11 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+import scipy.sparse as sp
 
 from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.geometry.intersections import self_intersections
-from meshvae_lib.geometry.topology import edge_lengths
+from meshvae_lib.geometry.topology import edge_lengths, edges
 
 __all__ = [
     "linear_steps",
@@ -36,6 +39,7 @@ __all__ = [
     "interpolate_features",
     "LatentPath",
     "edge_length_distortion",
+    "vertex_edge_stretch",
     "implausibility",
     "ImplausibilityTable",
 ]
@@ -200,6 +204,37 @@ def edge_length_distortion(V, F, dataset, chunk: int = 64) -> tuple[np.ndarray, 
     if single:
         return float(best[0]), int(nearest[0])
     return best, nearest.astype(np.int64)
+
+
+def vertex_edge_stretch(V, V_ref, F) -> np.ndarray:
+    """Relative edge-length change against one reference mesh, averaged at each vertex.
+
+    ``s_e = |l_e(V) - l_e(V_ref)| / l_e(V_ref)`` per undirected edge, and per vertex the mean of
+    ``s_e`` over the edges that meet there. Zero for a rigid motion of ``V_ref``, ``|c - 1|``
+    everywhere for ``c V_ref``; colour a mesh by it to see where it stretches or shrinks.
+
+    Parameters
+    ----------
+    V : (n_vertices, 3) or (N, n_vertices, 3) float
+    V_ref : (n_vertices, 3) float
+    F : (n_faces, 3) int
+
+    Returns
+    -------
+    stretch : (n_vertices,) or (N, n_vertices) float64, non-negative
+    """
+    V = np.asarray(V, dtype=np.float64)
+    V_ref = np.asarray(V_ref, dtype=np.float64)
+    if V_ref.ndim != 2 or V.shape[-2:] != V_ref.shape:
+        raise ValueError(f"V_ref must be one mesh of the same vertex count as V {V.shape}, got {V_ref.shape}")
+    E = edges(F)
+    s = np.abs(edge_lengths(V, F) / np.maximum(edge_lengths(V_ref, F), np.finfo(float).tiny) - 1.0)
+    n, m = V_ref.shape[0], len(E)
+    # (n, m) vertex-edge incidence, each row scaled by 1 / the vertex's degree: one sparse product
+    degree = np.bincount(E.ravel(), minlength=n)
+    A = sp.csr_matrix((np.ones(2 * m), (E.T.ravel(), np.tile(np.arange(m), 2))), shape=(n, m))
+    out = (A @ s.reshape(-1, m).T).T / np.maximum(degree, 1)
+    return out.reshape(V.shape[:-1])
 
 
 # --------------------------------------------------------------------------------------------
