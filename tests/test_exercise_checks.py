@@ -54,12 +54,23 @@ WRONG_ANSWERS = {
     },
     ("02_rimd", 2): {
         "V_lin is the feature midpoint": (
-            "Va, Vb = col.vertices[poses[0]], col.vertices[poses[2]]\n"
-            "fa, fb = enc.transform(Va), enc.transform(Vb)\n"
-            "V_mid = rec['exact'].reconstruct(0.5 * (fa + fb))\n"
+            "Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n"
+            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
             "V_lin = V_mid.copy()\n"
-            "len_mid = len_lin = np.linalg.norm(V_mid[E[:, 0]] - V_mid[E[:, 1]], axis=1).mean()\n"
-            "len_ref = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1).mean()\n"),
+            "L0 = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1)\n"
+            "stretch_mid = stretch_lin = float(np.mean(np.abs(np.linalg.norm(V_mid[E[:, 0]] - V_mid[E[:, 1]], axis=1) / L0 - 1)))\n"),
+        "the two poses of the first attempt": (
+            "Va, Vb = col.vertices[poses[0]], col.vertices[poses[2]]\n"
+            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
+            "V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n"
+            "L0 = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1)\n"
+            "stretch_mid, stretch_lin = (float(np.mean(np.abs(np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1) / L0 - 1)))"
+            " for X in (V_mid, V_lin))\n"),
+        "stretch as the vertex average": (
+            "Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n"
+            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
+            "V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n"
+            "stretch_mid, stretch_lin = (float(vertex_edge_stretch(X, V0, F).mean()) for X in (V_mid, V_lin))\n"),
     },
     ("03_normalization", 2): {
         "margin typed in from the text": (
@@ -74,6 +85,15 @@ WRONG_ANSWERS = {
             "x = x_hat = mu = torch.zeros(8, 4)\n"
             "sigma = torch.ones(8, 4)\n"
             "rec_term = kl_term = 0.0\n"),
+    },
+    ("04_training", 3): {
+        "a threshold typed in from the text": "alpha_off = np.full(LATENT, 1e3)\n",
+        "sigma = 1/sqrt(2) instead of 0.5 (K / c^2)": (
+            "c_paper = decoder_column_norms(model.network, model.encode_meshes(train_V, inference='encoder')).mean(axis=0)\n"
+            "alpha_off = model.n_features / c_paper ** 2\n"),
+        "column norms at the held-out meshes": (
+            "c_paper = decoder_column_norms(model.network, model.encode_meshes(col.vertices[held_out], inference='encoder')).mean(axis=0)\n"
+            "alpha_off = 3 * model.n_features / c_paper ** 2\n"),
     },
     ("07_sigma_object_embeddings", 1): {
         "the check's own expression": "gap = exact - sibling\n",
@@ -95,6 +115,18 @@ WRONG_ANSWERS = {
             "pca_err = rows['jumping']['ours aligned']\n"
             "rimd_over_pca = rows['jumping']['ours rimd'] / pca_err\n"),
         "a floor of zero": "pca_err = 0.0\nrimd_over_pca = float('inf')\n",
+    },
+    ("09_evaluation", 3): {
+        "the threshold applied to the learned errors": (
+            "floor_rel = {name: rows[name]['ours rimd'] for name in rows}\n"
+            "informative = [name for name in rows if floor_rel[name] >= 1e-4]\n"),
+        "absolute floors, not relative to the diagonal": (
+            "floor_rel = {}\n"
+            "for name in rows:\n"
+            "    coll = paper.load_collection(name, full.settings)\n"
+            "    held = holdout_mask(len(coll.vertices), full.settings.holdout_every)\n"
+            "    floor_rel[name] = float(pca_baseline(coll.vertices[~held], coll.vertices[held])['mean_vertex_error'])\n"
+            "informative = [name for name in rows if floor_rel[name] >= 1e-4]\n"),
     },
     ("10_bring_your_own", 1): {
         "any three meshes of the data": (
