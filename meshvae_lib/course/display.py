@@ -51,10 +51,15 @@ def real_inference_table(rows) -> str:
     """The recorded real-mesh comparison (``docs/results/inference_real.json``'s ``rows``: dicts with
     ``collection``, ``paper_path`` (or None), ``encoder``, ``default``, ``pca_coords``) as a
     fixed-width table: held-out errors of the paper's path, the encoder, the default inference and
-    PCA on coordinates, and default / PCA. Recorded numbers, the same on every machine."""
-    lines = [f"{'collection':10s} {'paper path':>10s} {'encoder':>9s} {'default':>9s} {'PCA coords':>10s} {'default / PCA':>13s}"]
+    PCA on coordinates, then each of the three divided by PCA's. Recorded numbers, the same on every
+    machine."""
+    lines = [f"{'collection':10s} {'paper path':>10s} {'encoder':>9s} {'default':>9s} {'PCA coords':>10s} |"
+             f" divided by PCA: paper path, encoder, default"]
     for r in rows:
-        paper_path = "-" if r.get("paper_path") is None else f"{r['paper_path']:.2e}"
+        paper = r.get("paper_path")
+        paper_path = "-" if paper is None else f"{paper:.2e}"
+        paper_ratio = "-" if paper is None else f"{paper / r['pca_coords']:.2f}"
         lines.append(f"{r['collection']:10s} {paper_path:>10s} {r['encoder']:9.2e} {r['default']:9.2e}"
-                     f" {r['pca_coords']:10.2e} {r['default'] / r['pca_coords']:13.2f}")
+                     f" {r['pca_coords']:10.2e} | {paper_ratio:>15s} {r['encoder'] / r['pca_coords']:8.2f}"
+                     f" {r['default'] / r['pca_coords']:8.2f}")
     return "\n".join(lines)
