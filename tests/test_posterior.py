@@ -77,6 +77,17 @@ def test_column_norms_match_autograd(hidden):
     assert decoder_column_norms(net, mu[0]).shape == (4,)
 
 
+def test_decoder_sigma_uses_eval_mode_and_restores_the_mode():
+    torch.manual_seed(3)
+    net = MeshVAE(n_features=30, latent_dim=3, hidden=(8,))
+    net.train()
+    mu = np.zeros((2, 3))
+    got = decoder_sigma(net, mu, 1e3)
+    assert net.training, "the caller's mode is restored"
+    net.eval()
+    assert np.array_equal(got, decoder_sigma(net, mu, 1e3)) and not net.training
+
+
 def test_decoder_sigma_checks_its_input():
     net = MeshVAE(n_features=20, latent_dim=4)
     with pytest.raises(ValueError, match=r"\(N, 4\).*\(2, 3\)"):

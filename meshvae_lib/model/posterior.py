@@ -86,7 +86,7 @@ def decoder_sigma(network, mu, alpha: float) -> np.ndarray:
 
     Parameters
     ----------
-    network : MeshVAE without conditions (put in eval mode here)
+    network : MeshVAE without conditions (evaluated in eval mode; its mode is restored)
     mu : (N, D) or (D,) float
     alpha : float > 0
 
@@ -94,5 +94,9 @@ def decoder_sigma(network, mu, alpha: float) -> np.ndarray:
     -------
     sigma : (N, D) float64 in (0, 1] (or (D,) for one code)
     """
+    was_training = network.training
     network.eval()
-    return linear_gaussian_sigma(decoder_column_norms(network, mu), alpha, network.n_features)
+    try:
+        return linear_gaussian_sigma(decoder_column_norms(network, mu), alpha, network.n_features)
+    finally:
+        network.train(was_training)
