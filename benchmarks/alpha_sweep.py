@@ -24,7 +24,6 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import time
 from pathlib import Path
 
@@ -37,8 +36,7 @@ from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.posterior import decoder_sigma
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import holdout_mask
-
-ROOT = Path(__file__).resolve().parents[1]
+from provenance import cpu_name, source_state
 
 
 def run_one(coll, alpha: float, seed: int, epochs: int, args) -> dict:
@@ -91,20 +89,9 @@ def markdown(record: dict) -> str:
 
 
 def provenance(args) -> dict:
-    def git(*a):
-        try:
-            return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
-        except (OSError, subprocess.CalledProcessError):
-            return None
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return {"commit": git("rev-parse", "HEAD"), "uncommitted_changes": bool(git("status", "--porcelain", "--untracked-files=no")),
+    return {**source_state(),
             "versions": {"python": platform.python_version(), "numpy": np.__version__, "torch": torch.__version__},
-            "machine": {"cpu": cpu, "cores": os.cpu_count(), "torch_threads": args.threads,
+            "machine": {"cpu": cpu_name(), "cores": os.cpu_count(), "torch_threads": args.threads,
                         "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
                         "npy_disable_cpu_features": os.environ.get("NPY_DISABLE_CPU_FEATURES")}}
 

@@ -126,27 +126,16 @@ def _write_summary(out, args, settings, total, parts, results, failed, done: boo
 def _provenance(args, settings) -> dict:
     """What the numbers depend on: the experiments' definitions, the commit, versions, the machine."""
     import platform
-    import subprocess
 
     import scipy
     import torch
 
-    def git(*a):
-        try:
-            return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
-        except (OSError, subprocess.CalledProcessError):
-            return None
+    from provenance import cpu_name, source_state
 
-    cpu = platform.processor() or platform.machine()
-    try:
-        cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return {"definition_fingerprint": paper.definition_fingerprint(settings), "commit": git("rev-parse", "HEAD"),
-            "uncommitted_changes": bool(git("status", "--porcelain", "--untracked-files=no")),
+    return {"definition_fingerprint": paper.definition_fingerprint(settings), **source_state(),
             "versions": {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__,
                          "torch": torch.__version__},
-            "machine": {"cpu": cpu, "cores": os.cpu_count(), "torch_threads": args.threads, "system": platform.platform()},
+            "machine": {"cpu": cpu_name(), "cores": os.cpu_count(), "torch_threads": args.threads, "system": platform.platform()},
             "preset": "quick" if args.quick else "full"}
 
 
