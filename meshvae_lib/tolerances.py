@@ -138,15 +138,21 @@ TIE_RTOL = 1e-9
 # --- latent inference by Gauss-Newton (model.inference, issue 23) -------------------------------
 #: geometry.sparse_lu.solve_columns: right-hand sides per SuperLU solve (it slows beyond ~16).
 SPARSE_SOLVE_CHUNK = 12
-#: Levenberg-Marquardt damping of the Gauss-Newton inference, as a fraction of the mean diagonal of
-#: J^T J: where it starts, how it grows on a rejected step and shrinks on an accepted one, its floor
-#: and the number of tries per iteration before the fit stops. Measured on samba, pdance and pcow:
-#: undamped steps overshoot on the first iteration (the encoder's code is far off on real meshes).
+#: Levenberg-Marquardt damping of the Gauss-Newton inference, as a fraction of each diagonal entry of
+#: J^T J (Marquardt's scaling): where it starts, how it grows on a rejected step and shrinks on an
+#: accepted one, its floor and the number of tries per iteration before the fit stops. Measured on
+#: samba, pdance and pcow: undamped steps overshoot on the first iteration (the encoder's code is far
+#: off on real meshes). Damping by a multiple of the *mean* diagonal instead froze the latent
+#: directions that move the vertices little: on full pdance 4 steps left 2.5-6x the error of
+#: Marquardt's 4 steps (docs/vae.md, "Inference by Gauss-Newton").
 GN_DAMPING_START = 1e-3
 GN_DAMPING_UP = 10.0
 GN_DAMPING_DOWN = 0.3
 GN_DAMPING_FLOOR = 1e-5
 GN_MAX_TRIES = 6
+#: Marquardt's scaling never damps a direction by less than this fraction of the mean diagonal of
+#: J^T J (a latent direction the decoded mesh does not follow would otherwise get no damping).
+GN_DIAG_FLOOR_RTOL = 1e-9
 #: the fit stops early when an accepted step lowers the squared vertex error by less than this
 #: fraction.
 GN_REL_DECREASE = 1e-4

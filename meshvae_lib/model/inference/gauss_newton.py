@@ -32,7 +32,7 @@ __all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "GaussNewtonReport
 def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The output activation and its slope, in float64."""
     if network.output == "sigmoid":
-        r = 1.0 / (1.0 + np.exp(-y))
+        r = 0.5 * (1.0 + np.tanh(0.5 * y))          # the logistic function, without overflow far out
         return r, r * (1.0 - r)
     r = np.tanh(y)
     return r, 1.0 - r * r
@@ -237,10 +237,13 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
             mean_diag = float(np.trace(H)) / len(used)
             if not (mean_diag > 0 and np.isfinite(H).all() and np.isfinite(g).all()):
                 break     # the decoded mesh does not move with the code here (a saturated output)
+            # Marquardt's scaling: each direction damped in proportion to its own curvature, so the
+            # latent directions that barely move the vertices are not frozen by the large ones
+            scale = np.maximum(np.diag(H), tol.GN_DIAG_FLOOR_RTOL * mean_diag)
             accepted = None
             for _ in range(tol.GN_MAX_TRIES):
                 z_new = Z[j].copy()
-                z_new[used] += np.linalg.solve(H + damping * mean_diag * np.eye(len(used)), g)
+                z_new[used] += np.linalg.solve(H + damping * np.diag(scale), g)
                 trial = decoder.state(z_new, c, V[j])
                 report.decodes[j] += 1
                 if trial.sq_error < state.sq_error:
