@@ -2,6 +2,8 @@
 
 import pickle
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -214,7 +216,9 @@ def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
 def test_fit_leaves_its_constructor_arguments_and_exposes_the_mesh(collection):
     model = MeshVAEModel("coords", None, holdout_every=4)
     model.fit(collection)
-    assert model.config is None and model.train_config_ == TrainConfig()   # defaults used, argument kept
+    # defaults used, argument kept; the latent size resolved (few meshes: the paper's 128)
+    assert model.config is None and model.train_config_ == replace(TrainConfig(), latent_dim=128)
+    assert TrainConfig().latent_dim is None and model.latent_dim == 128
     np.testing.assert_array_equal(model.reference_vertices, collection.vertices[0])
     np.testing.assert_array_equal(model.faces, collection.faces)
     for arr in (model.reference_vertices, model.faces):

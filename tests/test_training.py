@@ -297,3 +297,31 @@ def test_network_options_come_from_the_config_and_are_checked():
             TrainConfig(**bad)
     with pytest.raises(ValueError, match="output"):
         train_vae(X, config=TrainConfig(epochs=1, progress=False), model=MeshVAE(30, 4, output="sigmoid"))
+
+
+def test_the_default_latent_size_covers_every_direction_of_a_pca_start():
+    cfg = TrainConfig()
+    assert cfg.latent_dim is None
+    # the paper's 128 up to 129 rows; beyond, one dimension per direction N rows span, up to 256
+    assert [cfg.resolved_latent_dim(n) for n in (2, 100, 129, 130, 165, 257, 5000)] == [128, 128, 128, 129, 164, 256, 256]
+    # networks without the PCA start keep the paper's 128; an explicit size always wins
+    for other in (TrainConfig(init="random"), TrainConfig(hidden=(8,)), TrainConfig(sigma_object=(0.1,))):
+        assert other.resolved_latent_dim(200) == 128
+    assert cfg.resolved_latent_dim(200, n_conditions=1) == 128
+    assert TrainConfig(latent_dim=7).resolved_latent_dim(200) == 7
+    with pytest.raises(ValueError, match="latent_dim"):
+        TrainConfig(latent_dim=0)
+    # 150 rows spanning 149 directions: the default network reproduces every one of them, while the
+    # paper's 128 leaves the 21 smallest directions out (what held back the full real collections)
+    X = _in_range(n=150, k=200, rank=150)
+    x = torch.from_numpy(X.astype(np.float32))
+    residual = {}
+    for name, c in (("auto", TrainConfig(progress=False, early_stopping=False, epochs=1)),
+                    ("128", TrainConfig(progress=False, latent_dim=128))):
+        net = MeshVAE.from_pca(x, c).eval()
+        with torch.no_grad():
+            residual[name] = float(np.abs(net.decode(net.encode(x)[0]).double().numpy() - X).max())
+        assert net.latent_dim == (149 if name == "auto" else 128)
+    assert residual["auto"] < 2e-4 < 0.005 < residual["128"], residual
+    res = train_vae(X, config=TrainConfig(epochs=1, progress=False, early_stopping=False))
+    assert res.model.latent_dim == 149 and res.model.input_rank == 149

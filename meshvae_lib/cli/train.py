@@ -6,7 +6,7 @@ import argparse
 import logging
 
 from meshvae_lib.defaults import DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
-from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
                note, result)
@@ -50,7 +50,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--features", choices=FEATURE_KINDS, default=DEFAULT_FEATURE_KIND,
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
                    f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND})")
-    p.add_argument("--latent", type=int, default=DEFAULT_LATENT, metavar="D", help=f"latent size (default {DEFAULT_LATENT})")
+    p.add_argument("--latent", type=int, default=None, metavar="D",
+                   help=f"latent size (default {DEFAULT_LATENT}, or with the PCA start one per direction the training"
+                        f" meshes span when that is more, up to {PCA_LATENT_MAX})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
                    help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS})")
     p.add_argument("--init", choices=INIT_MODES, default=DEFAULT_INIT,
@@ -89,9 +91,10 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import read_collection
     from meshvae_lib.model.train_config import TrainConfig, default_hidden
 
-    check_at_least(args.latent, 1, "--latent")
-    if args.sigma_object is not None and len(args.sigma_object) > args.latent:
-        raise UsageError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent}")
+    if args.latent is not None:
+        check_at_least(args.latent, 1, "--latent")
+    if args.sigma_object is not None and len(args.sigma_object) > (args.latent or DEFAULT_LATENT):
+        raise UsageError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent or DEFAULT_LATENT}")
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     d = TrainConfig()
     epochs = args.epochs if args.epochs is not None else d.epochs
@@ -103,7 +106,7 @@ def run(args) -> int:
                          device=args.device, progress=not args.no_progress)
     at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
     note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
-         f" latent {args.latent}, hidden {list(hidden)}, {at_most}{epochs} epochs")
+         f" latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference)
     try:
@@ -116,7 +119,7 @@ def run(args) -> int:
         result(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
                f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
     result(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"
-           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.n_features}")
+           f" {last['reconstruction']:.4g}, KL {last['kl']:.4g}), K = {model.n_features}, latent {model.latent_dim}")
     if model.holdout_mask_.any():
         res = evaluate_model(model, collection, held_out_only=True, progress=not args.no_progress)
         result(f"held-out per-vertex error: {res['mean_vertex_error']:.6g} over {res['n_meshes']} meshes"

@@ -70,8 +70,8 @@ class MeshVAEModel:
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
-    train_config_ : TrainConfig the network was trained with (``config``, or the defaults when it
-        was None; ``config`` itself is left as given).
+    train_config_ : TrainConfig the network was trained with (``config`` or the defaults, its latent
+        size resolved; ``config`` itself is left as given).
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`).
     train_seconds_ : float.
     train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
@@ -131,7 +131,7 @@ class MeshVAEModel:
         self.holdout_mask_ = mask
         self.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
         self.sigma_object_ = so if so is not None and config.prior_form == "exact" else np.ones(D)
-        self.train_config_ = config
+        self.train_config_ = TrainConfig(**{**config.to_dict(), "latent_dim": D})
         return self
 
     # -- what it is ----------------------------------------------------------------------------

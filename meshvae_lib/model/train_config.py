@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_ARCHITECTURE, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS,
-                                  DEFAULT_FEATURE_KIND, DEFAULT_INIT, DEFAULT_LATENT, DEFAULT_LR,
+                                  DEFAULT_FEATURE_KIND, DEFAULT_INIT, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX,
                                   EARLY_STOPPING_PATIENCE, INIT_MODES, LOSSES, NORMALIZE_A, OUTPUTS,
                                   PCA_NORMALIZE_A, PRIOR_FORMS, VALIDATION_EVERY)
 from meshvae_lib.model.feature_kinds import kind_class
@@ -56,7 +56,11 @@ class TrainConfig:
         which batch norm cannot handle).
     lr : Adam learning rate (paper: 1e-3).
     alpha : weight of the reconstruction term (Eq. 4; paper: 1e6).
-    latent_dim : D (paper: 128).
+    latent_dim : D (paper: 128). None (default): 128, except for a network that starts at the
+        PCA of its rows (``uses_pca_init``), which gets one dimension per direction its N training
+        rows span, ``N - 1``, when that is more (at most ``PCA_LATENT_MAX``): with fewer, the PCA
+        start drops the smallest directions and the training meshes themselves are not reproduced
+        (:meth:`resolved_latent_dim`; docs/vae.md, "Inference by Gauss-Newton").
     hidden : internal layer sizes, outermost first (default: none).
     sigma_object : prior deviations (length D) or None for N(0, I) (Sec. 4.4). Shorter vectors are
         padded with 1 by :func:`pad_sigma_object`.
@@ -109,7 +113,7 @@ class TrainConfig:
     batch_size: int = DEFAULT_BATCH_SIZE
     lr: float = DEFAULT_LR
     alpha: float = DEFAULT_ALPHA
-    latent_dim: int = DEFAULT_LATENT
+    latent_dim: int | None = None
     hidden: tuple[int, ...] = ()
     sigma_object: tuple[float, ...] | None = None
     prior_form: str = "exact"
@@ -135,6 +139,14 @@ class TrainConfig:
         see ``init``)."""
         return (self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
                 and self.output == "tanh")
+
+    def resolved_latent_dim(self, n_rows: int, n_conditions: int = 0) -> int:
+        """D for a new network trained on ``n_rows`` rows (see ``latent_dim``)."""
+        if self.latent_dim is not None:
+            return int(self.latent_dim)
+        if self.uses_pca_init(n_conditions):
+            return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
+        return DEFAULT_LATENT
 
     def resolved_a(self, n_conditions: int = 0) -> float:
         """a of Eq. 3 (see ``a``)."""
@@ -165,7 +177,7 @@ class TrainConfig:
             "batch_size": self.batch_size >= 2,
             "lr": self.lr > 0,
             "alpha": self.alpha > 0,
-            "latent_dim": self.latent_dim >= 1,
+            "latent_dim": self.latent_dim is None or int(self.latent_dim) >= 1,
             "eval_every": self.eval_every >= 1,
             "prior_form": self.prior_form in PRIOR_FORMS,
             "init": self.init in INIT_MODES,

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
@@ -325,6 +325,8 @@ def train_vae(
     x, c, xv, cv = _rows(features, conditions, val_features, val_conditions)
     n, k = x.shape
     n_cond = 0 if c is None else c.shape[1]
+    if config.latent_dim is None:
+        config = replace(config, latent_dim=model.latent_dim if model is not None else config.resolved_latent_dim(n, n_cond))
     device = resolve_device(config.device)
     if model is not None:
         _check_given(model, k, n_cond, config)

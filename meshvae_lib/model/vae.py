@@ -173,15 +173,15 @@ class MeshVAE(nn.Module):
         caller)."""
         if config.uses_pca_init(n_conditions):
             return cls.from_pca(x, config, n_conditions)
-        return cls(x.shape[1], config.latent_dim, config.hidden, n_conditions, sigma_floor=config.sigma_floor,
-                   output=config.output)
+        return cls(x.shape[1], config.resolved_latent_dim(x.shape[0], n_conditions), config.hidden, n_conditions,
+                   sigma_floor=config.sigma_floor, output=config.output)
 
     @classmethod
     def from_pca(cls, x: torch.Tensor, config, n_conditions: int = 0) -> "MeshVAE":
         """A network without internal layers whose decoded means start as the training rows' PCA.
 
-        x : (N, K) float32 normalised training rows (N >= 2); config : the latent size, alpha and
-        sigma_floor come from it (``config.hidden`` must be empty, ``config.output`` "tanh"). The
+        x : (N, K) float32 normalised training rows (N >= 2); config : the latent size
+        (``config.resolved_latent_dim(N)``), alpha and sigma_floor come from it (``config.hidden`` must be empty, ``config.output`` "tanh"). The
         input projection, encoder and decoder start as :func:`~meshvae_lib.model.pca_start.pca_start`
         says (the deviation is 1 in the latent dimensions beyond its rank, where the latent cost is
         then 0); condition inputs start with zero weights. Returns the network in train mode.
@@ -190,8 +190,9 @@ class MeshVAE(nn.Module):
             raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
         if config.output != "tanh":
             raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
-        start = pca_start(x.detach().double().cpu().numpy(), config.latent_dim, config.alpha)
-        r, D = start.rank, config.latent_dim
+        D = config.resolved_latent_dim(x.shape[0], n_conditions)
+        start = pca_start(x.detach().double().cpu().numpy(), D, config.alpha)
+        r = start.rank
         net = cls(x.shape[1], D, (), n_conditions, input_rank=r, sigma_floor=config.sigma_floor)
         sigma_logit = np.log(start.sigma / (net.sigma_max - start.sigma))
         f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
