@@ -54,11 +54,13 @@ def load_real(name: str, subsample: int = 1) -> MeshCollection:
     return MeshCollection(V, np.asarray(d["faces"]), names=[str(n) for n in np.asarray(d["names"])[::subsample]])
 
 
-def config_for(kind: str, legacy: bool, seed: int, epochs: int | None) -> TrainConfig:
+def config_for(kind: str, legacy: bool, seed: int, epochs: int | None, latent: int | None = None) -> TrainConfig:
     extra = {} if epochs is None else {"epochs": epochs}
+    if latent is not None:
+        extra["latent_dim"] = latent
     if legacy:
         hidden = () if kind == "rimd" else (256,)
-        return TrainConfig(hidden=hidden, init="random", early_stopping=False, feature_range=0.9, seed=seed,
+        return TrainConfig(hidden=hidden, init="random", early_stopping=False, a=0.9, seed=seed,
                            progress=False, device="cpu", **extra)
     return TrainConfig(seed=seed, progress=False, device="cpu", init="pca", **extra)
 
@@ -75,7 +77,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
     rows = []
     for kind in args.kinds.split(","):
         t0 = time.perf_counter()
-        model = MeshVAEModel(kind, config_for(kind, args.legacy, args.seed, args.epochs),
+        model = MeshVAEModel(kind, config_for(kind, args.legacy, args.seed, args.epochs, args.latent),
                              holdout_every=args.holdout_every).fit(coll)
         seconds = time.perf_counter() - t0
         if args.save_models:
@@ -86,7 +88,8 @@ def run_collection(coll, name: str, args) -> list[dict]:
             held = evaluate_model(model, coll, held_out_only=True, inference=inference)
             label = kind if inference == "gauss-newton" else f"{kind} ({inference})"
             row = {"collection": name, "features": label, "kind": kind, "inference": inference,
-                   "K": int(model.n_features), "train_error": train["mean_vertex_error"],
+                   "K": int(model.n_features), "latent": int(model.latent_dim),
+                   "used_latent": int(len(model.used_latent_dims)), "train_error": train["mean_vertex_error"],
                    "held_out_error": held["mean_vertex_error"], "relative_error": held["relative_error"],
                    "epochs": int(model.train_epochs_), "seconds": seconds,
                    "encode_seconds_per_mesh": held["seconds_per_mesh"],
@@ -106,7 +109,7 @@ def run_collection(coll, name: str, args) -> list[dict]:
             print(f"{label:26s} {row['K']:7d} {'':>12s} {fitted['mean_vertex_error']:10.4e}"
                   f" {100 * fitted['relative_error']:7.3f} {'':>6s} {seconds:9.1f} {fitted['seconds_per_mesh']:9.3f}"
                   "   (codes fitted by finite differences)", flush=True)
-    latent = TrainConfig().latent_dim
+    latent = args.latent or TrainConfig().resolved_latent_dim(int((~mask).sum()))
     pcas = [(False, None), (True, None)]
     if int((~mask).sum()) - 1 > latent:  # the VAE has only D latent dimensions: PCA with as many too
         pcas += [(False, latent), (True, latent)]
@@ -142,6 +145,7 @@ def main() -> None:
     ap.add_argument("--holdout-every", type=int, default=5)
     ap.add_argument("--kinds", default=",".join(KINDS))
     ap.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainConfig's)")
+    ap.add_argument("--latent", type=int, default=None, help="latent size (default: TrainConfig's)")
     ap.add_argument("--legacy", action="store_true", help="the paper's training instead of the library's default (the PCA start)")
     ap.add_argument("--inference", default="gauss-newton,encoder",
                     help="comma-separated inference strategies to evaluate every model with (MeshVAEModel.encode_meshes;"
