@@ -40,9 +40,12 @@ def test_bad_input_says_what_is_wrong():
 def test_real_inference_table_prints_the_recorded_rows_and_their_ratio():
     from meshvae_lib.course.display import real_inference_table
 
-    rows = [{"collection": "a/3", "paper_path": 0.5, "encoder": 0.25, "default": 0.01, "pca_coords": 0.04},
-            {"collection": "b", "paper_path": None, "encoder": 1.0, "default": 3.0, "pca_coords": 1.5}]
+    rows = [{"collection": "a/3", "paper_path": 0.5, "encoder": 0.25, "default": 0.01, "pca_coords": 0.04,
+             "pca_aligned": 0.02},
+            {"collection": "b", "paper_path": None, "encoder": 1.0, "default": 3.0, "pca_coords": 1.5, "pca_aligned": 4.0}]
     lines = real_inference_table(rows).splitlines()
     assert len(lines) == 3 and lines[0].split()[:2] == ["collection", "paper"]
-    assert lines[1].split() == ["a/3", "5.00e-01", "2.50e-01", "1.00e-02", "4.00e-02", "|", "12.50", "6.25", "0.25"]
-    assert lines[2].split() == ["b", "-", "1.00e+00", "3.00e+00", "1.50e+00", "|", "-", "0.67", "2.00"]
+    assert lines[1].split() == ["a/3", "5.00e-01", "2.50e-01", "1.00e-02", "4.00e-02", "2.00e-02", "|", "12.50", "6.25",
+                                "0.25", "|", "0.50"]
+    assert lines[2].split() == ["b", "-", "1.00e+00", "3.00e+00", "1.50e+00", "4.00e+00", "|", "-", "0.67", "2.00",
+                                "|", "0.75"]
