@@ -9,7 +9,8 @@ mean relative edge-length change against the nearest *training* mesh:
 - latent paths: for consecutive pairs of held-out meshes, their codes (the default inference), and
   ``--steps`` meshes decoded along the straight line between them (end points excluded).
 
-The ratios samples / held-out and paths / held-out are the figures of issue 23 (target: at most 1.5).
+The ratios samples / held-out and paths / held-out are the figures of issue 23 (target: at most 1.5);
+``--temperatures`` adds the ratios of prior samples drawn at lower temperatures (``generate(temperature=...)``).
 
     python benchmarks/bench_generation_stretch.py                       # samba and pcow when present
     python benchmarks/bench_generation_stretch.py --real pcow --subsample 3
@@ -28,6 +29,7 @@ import torch
 
 from feature_comparison import SHARED_DATA, load_real
 from meshvae_lib.applications.interpolation import edge_length_distortion
+from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 
@@ -47,7 +49,18 @@ def measure(coll, name: str, args) -> dict:
     mask = model.holdout_mask_
     train, held = V[~mask], V[mask]
     real, _ = edge_length_distortion(held, F, train)
-    samples, _ = edge_length_distortion(model.generate(args.samples, seed=args.seed), F, train)
+    drawn = model.generate(args.samples, seed=args.seed)
+    samples, _ = edge_length_distortion(drawn, F, train)
+    # variety: how far the samples lie from their own mean, over the same for the training meshes
+    # (rigidly aligned to the reference, as decoded meshes are)
+    ref = model.reference_vertices
+    aligned = np.stack([rigid_align(x, ref) for x in train])
+    spread = lambda M: float(np.linalg.norm(M - M.mean(axis=0), axis=-1).mean())  # noqa: E731
+    data_spread = spread(aligned)
+    tempered = {}
+    for t in args.temperatures:
+        M = model.generate(args.samples, seed=args.seed, temperature=t)
+        tempered[t] = (float(edge_length_distortion(M, F, train)[0].mean()), spread(M) / data_spread)
     z = model.encode_meshes(held)
     t = np.linspace(0.0, 1.0, args.steps + 2)[1:-1]
     path_z = np.concatenate([(1 - t)[:, None] * z[k] + t[:, None] * z[k + 1] for k in range(len(z) - 1)])
@@ -55,11 +68,16 @@ def measure(coll, name: str, args) -> dict:
     row = {"collection": name, "n_train": int((~mask).sum()), "n_held_out": int(mask.sum()),
            "held_out_real": float(real.mean()), "prior_samples": float(samples.mean()),
            "latent_paths": float(paths.mean()), "samples_ratio": float(samples.mean() / real.mean()),
-           "paths_ratio": float(paths.mean() / real.mean()), "train_seconds": train_s}
+           "paths_ratio": float(paths.mean() / real.mean()), "train_seconds": train_s,
+           "samples_variety": spread(drawn) / data_spread,
+           "tempered": {str(t): {"samples_ratio": v / float(real.mean()), "variety": var} for t, (v, var) in tempered.items()}}
     print(f"{name:10s} held-out real {row['held_out_real']:.4f}  prior samples {row['prior_samples']:.4f}"
           f" ({row['samples_ratio']:.2f}x)  latent paths {row['latent_paths']:.4f} ({row['paths_ratio']:.2f}x)"
           f"  [{row['n_train']} train / {row['n_held_out']} held out; {args.samples} samples;"
           f" {len(path_z)} path meshes]", flush=True)
+    print(f"{'':10s} prior samples' variety {row['samples_variety']:.2f} of the training meshes' spread", flush=True)
+    for t, r in row["tempered"].items():
+        print(f"{'':10s} prior samples at temperature {t}: {r['samples_ratio']:.2f}x, variety {r['variety']:.2f}", flush=True)
     return row
 
 
@@ -71,6 +89,8 @@ def main() -> None:
     ap.add_argument("--holdout-every", type=int, default=5)
     ap.add_argument("--samples", type=int, default=32)
     ap.add_argument("--steps", type=int, default=3)
+    ap.add_argument("--temperatures", type=lambda t: [float(x) for x in t.split(",") if x], default=[0.7, 0.5],
+                    help="also measure prior samples drawn at these temperatures (model.generate(temperature=...))")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--models", default=None, metavar="DIR",

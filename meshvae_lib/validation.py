@@ -301,6 +301,28 @@ def check_count(value, name: str, minimum: int = 0) -> int:
     return int(value)
 
 
+def check_positive(value, name: str) -> float:
+    """A finite number > 0 (a temperature, a scale).
+
+    Parameters
+    ----------
+    value : int or float
+    name : str
+        The argument's name in error messages.
+
+    Returns
+    -------
+    value : float
+    """
+    try:
+        ok = bool(np.isfinite(float(value)) and float(value) > 0)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
 def check_samples(X, name: str = "X") -> np.ndarray:
     """A data matrix of at least two finite samples (the rows an embedding or a retrieval ranks).
 

@@ -10,6 +10,7 @@ from geometry_fixtures import strip
 from meshvae_lib.cli import main
 from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.geometry.collection_io import read_collection, write_collection
+from meshvae_lib.model.meshvae_model import load_model
 from meshvae_lib.geometry.mesh_files import write_mesh
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
@@ -73,6 +74,13 @@ def test_generate_to_npz_and_folder(data):
     assert len(objs) == 2
     # same seed, same meshes, in either format
     np.testing.assert_allclose(read_collection(root / "gen_dir").vertices, gen.vertices[:2], atol=1e-9)
+    # a temperature: the library's draws at that temperature, not the default ones
+    assert main(["generate", str(model), "-n", "3", "-o", str(root / "cool.npz"), "--seed", "2", "--temperature", "0.5"]) == 0
+    cool = read_collection(root / "cool.npz").vertices
+    np.testing.assert_allclose(cool, load_model(model).generate(3, seed=2, temperature=0.5), atol=1e-9)
+    assert not np.allclose(cool, gen.vertices, atol=1e-6)
+    for bad in ("0", "-1", "inf", "nan"):
+        assert main(["generate", str(model), "-n", "1", "-o", str(root / "bad.npz"), "--temperature", bad]) == 2
 
 
 def test_interpolate_indices_and_files(data):

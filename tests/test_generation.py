@@ -62,6 +62,29 @@ def test_prior_draws_shape_seed_and_scale():
         model.sample_latent(0)
 
 
+def test_a_temperature_scales_the_prior_draws_and_brings_samples_nearer_the_mean():
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.model.train_config import TrainConfig
+
+    cfg = TrainConfig(epochs=2, batch_size=4, latent_dim=3, seed=0, device="cpu", progress=False,
+                      sigma_object=(0.1, 0.5, 1.0), prior_form="exact", init="random")
+    model = MeshVAEModel(features="coords", config=cfg).fit(_tiny_collection())
+    z1 = model.sample_latent(50, seed=3)
+    np.testing.assert_array_equal(model.sample_latent(50, seed=3, temperature=0.5), 0.5 * z1)
+    np.testing.assert_array_equal(model.sample_latent(50, seed=3, temperature=1), z1)   # the paper's prior
+    V, z, _ = model.generate(50, seed=3, temperature=0.25, return_latents=True)
+    np.testing.assert_array_equal(z, 0.25 * z1)
+    np.testing.assert_array_equal(V, model.decode_latent(z))
+    # decoded samples move towards the mesh of the prior's mean as the temperature falls
+    centre = model.decode_latent(np.zeros(3))
+    spread = {t: float(np.linalg.norm(model.generate(50, seed=3, temperature=t) - centre, axis=-1).mean())
+              for t in (1.0, 0.5, 0.25)}
+    assert spread[0.25] < spread[0.5] < spread[1.0], spread
+    for bad in (0, -1.0, float("nan"), float("inf"), "warm"):
+        with pytest.raises(ValueError, match="temperature must be a finite number > 0"):
+            model.sample_latent(3, temperature=bad)
+
+
 def test_nearest_neighbors_against_brute_force(rng):
     Q = rng.normal(size=(37, 6))
     D = rng.normal(size=(23, 6))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from meshvae_lib.validation import (
-    check_choice, check_count, check_faces, check_finite, check_matrices, check_mesh, check_rows,
+    check_choice, check_count, check_faces, check_finite, check_matrices, check_mesh, check_positive, check_rows,
     check_vectors, check_vertices)
 
 
@@ -80,6 +80,11 @@ def test_finite_choice_count():
             check_count(bad, "n")
     with pytest.raises(ValueError, match=r"n_steps must be an integer >= 2, got 1"):
         check_count(1, "n_steps", minimum=2)
+    assert check_positive(2, "t") == 2.0 and isinstance(check_positive(2, "t"), float)
+    assert check_positive(np.float32(1e-30), "t") > 0
+    for bad in (0, -0.5, np.nan, np.inf, "x", None):
+        with pytest.raises(ValueError, match="t must be a finite number > 0, got"):
+            check_positive(bad, "t")
 
 
 def test_check_is_fitted_raises_one_not_fitted_error():

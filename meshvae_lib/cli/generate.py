@@ -8,12 +8,14 @@ from . import UsageError, add_command, add_model_argument, add_output_argument, 
 
 DESCRIPTION = """\
 Draw N latent vectors from the prior N(0, diag(sigma_object^2)) and decode them into meshes
-(paper Sec. 5, "Generation"). For a conditional model, --condition COLUMN=VALUE fixes a label
+(paper Sec. 5, "Generation"). --temperature T < 1 scales the prior's deviations down: meshes nearer
+the training poses, less varied (docs/vae.md). For a conditional model, --condition COLUMN=VALUE fixes a label
 (repeat for several columns); columns left unset take the labels of random training meshes.
 OUT ending in .npz gets an .npz collection, any other OUT a folder of OBJ files.
 
 examples:
   meshvae generate scape.pt -n 10 -o generated/
+  meshvae generate scape.pt -n 10 -o calmer/ --temperature 0.7
   meshvae generate dyna_cond.pt -n 8 -o running.npz --condition motion=running_on_spot --seed 3
 """
 
@@ -33,6 +35,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--condition", type=_condition, action="append", default=[], metavar="COLUMN=VALUE",
                    help="label value for a conditional model (repeatable)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
+    p.add_argument("--temperature", type=float, default=1.0, metavar="T",
+                   help="scale of the prior's deviations (default 1: the paper's prior; lower: nearer the training poses)")
     return p
 
 
@@ -43,12 +47,14 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import write_collection
 
     check_at_least(args.n, 1, "-n")
+    if not args.temperature > 0 or args.temperature == float("inf"):
+        raise UsageError(f"--temperature must be a finite number > 0, got {args.temperature}")
     model = load_model(args.model)
     condition = dict(args.condition)
     if condition and not model.is_conditional:
         raise UsageError("this model was trained without labels; --condition needs a conditional model"
                          " (meshvae train ... --labels COLUMN)")
-    V = model.generate(args.n, seed=args.seed, condition=condition or None)
+    V = model.generate(args.n, seed=args.seed, condition=condition or None, temperature=args.temperature)
     labels = {col: np.asarray([val] * args.n) for col, val in condition.items()}
     out = write_collection(args.output, V, model.faces,
                            names=[f"generated_{i:04d}" for i in range(args.n)], labels=labels or None)

@@ -31,7 +31,7 @@ from meshvae_lib.model.networks import network_from_config
 from meshvae_lib.model.normalization import FeatureNormalizer
 from meshvae_lib.model.train_config import TrainConfig, pad_sigma_object
 from meshvae_lib.model.training import from_output_range, train_vae, training_split
-from meshvae_lib.validation import check_count, check_is_fitted, check_rows, check_vertices
+from meshvae_lib.validation import check_count, check_is_fitted, check_positive, check_rows, check_vertices
 
 __all__ = ["MeshVAEModel", "load_model", "FITTED_ATTRIBUTES"]
 
@@ -218,8 +218,7 @@ class MeshVAEModel:
         return V
 
     def features_of(self, vertices) -> np.ndarray:
-        """Meshes (N, n, 3), one mesh or a collection -> normalised feature rows (N, K) float64
-        (what the network sees)."""
+        """Meshes (N, n, 3), one mesh or a collection -> normalised feature rows (N, K) float64 (network input)."""
         return self.normalizer_.transform(self.kind_.encode(self._meshes(vertices)))
 
     @torch.no_grad()
@@ -283,14 +282,15 @@ class MeshVAEModel:
         return self.decode_latent(z, conditions, labels)
 
     # -- the prior -----------------------------------------------------------------------------
-    def sample_latent(self, n: int, seed: int = 0) -> np.ndarray:
-        """n draws from the prior N(0, diag(sigma_object^2)): (n, D) float64."""
-        n = check_count(n, "n", minimum=1)
-        rng = np.random.default_rng(seed)
-        return rng.standard_normal((n, self.latent_dim)) * self.sigma_object_
+    def sample_latent(self, n: int, seed: int = 0, temperature: float = 1.0) -> np.ndarray:
+        """n draws from the prior N(0, diag(sigma_object^2)), deviations times ``temperature`` (1: the
+        paper's prior; below 1 the draws stay nearer the training poses, docs/vae.md): (n, D) float64."""
+        n, t = check_count(n, "n", minimum=1), check_positive(temperature, "temperature")
+        return np.random.default_rng(seed).standard_normal((n, self.latent_dim)) * self.sigma_object_ * t
 
-    def generate(self, n: int, seed: int = 0, condition: dict | None = None, return_latents: bool = False):
-        """n new meshes decoded from prior samples (Sec. 5, "Generation").
+    def generate(self, n: int, seed: int = 0, condition: dict | None = None, return_latents: bool = False,
+                 temperature: float = 1.0):
+        """n new meshes decoded from prior samples (Sec. 5, "Generation"; ``temperature``: :meth:`sample_latent`).
 
         ``condition``: ``{column: value}`` for a conditional model (unset columns are drawn from
         the training labels, seeded by ``seed``).
@@ -298,7 +298,7 @@ class MeshVAEModel:
         Returns ``V (n, n_vertices, 3) float64``, or with ``return_latents`` ``(V, z (n, D)
         float64, c (n, C) float32 or None)``: the prior draws and condition vectors behind them.
         """
-        z = self.sample_latent(n, seed)
+        z = self.sample_latent(n, seed, temperature)
         c = None
         if self.is_conditional:
             c = self.condition_vector(condition, n=n, seed=seed)
