@@ -49,18 +49,16 @@ def measure(coll, name: str, args) -> dict:
     mask = model.holdout_mask_
     train, held = V[~mask], V[mask]
     real, _ = edge_length_distortion(held, F, train)
-    drawn = model.generate(args.samples, seed=args.seed)
-    samples, _ = edge_length_distortion(drawn, F, train)
-    # variety: how far the samples lie from their own mean, over the same for the training meshes
-    # (rigidly aligned to the reference, as decoded meshes are)
-    ref = model.reference_vertices
-    aligned = np.stack([rigid_align(x, ref) for x in train])
+    # prior samples at the paper's temperature 1 and at --temperatures: their stretch, and their variety
+    # (how far they lie from their own mean, over the same for the training meshes rigidly aligned to
+    # the reference, as decoded meshes are)
     spread = lambda M: float(np.linalg.norm(M - M.mean(axis=0), axis=-1).mean())  # noqa: E731
-    data_spread = spread(aligned)
+    data_spread = spread(np.stack([rigid_align(x, model.reference_vertices) for x in train]))
     tempered = {}
-    for t in args.temperatures:
+    for t in [1.0] + [t for t in args.temperatures if t != 1.0]:
         M = model.generate(args.samples, seed=args.seed, temperature=t)
-        tempered[t] = (float(edge_length_distortion(M, F, train)[0].mean()), spread(M) / data_spread)
+        tempered[t] = (edge_length_distortion(M, F, train)[0], spread(M) / data_spread)
+    samples, variety = tempered.pop(1.0)
     z = model.encode_meshes(held)
     t = np.linspace(0.0, 1.0, args.steps + 2)[1:-1]
     path_z = np.concatenate([(1 - t)[:, None] * z[k] + t[:, None] * z[k + 1] for k in range(len(z) - 1)])
@@ -69,8 +67,9 @@ def measure(coll, name: str, args) -> dict:
            "held_out_real": float(real.mean()), "prior_samples": float(samples.mean()),
            "latent_paths": float(paths.mean()), "samples_ratio": float(samples.mean() / real.mean()),
            "paths_ratio": float(paths.mean() / real.mean()), "train_seconds": train_s,
-           "samples_variety": spread(drawn) / data_spread,
-           "tempered": {str(t): {"samples_ratio": v / float(real.mean()), "variety": var} for t, (v, var) in tempered.items()}}
+           "samples_variety": variety,
+           "tempered": {str(t): {"samples_ratio": float(v.mean() / real.mean()), "variety": var}
+                        for t, (v, var) in tempered.items()}}
     print(f"{name:10s} held-out real {row['held_out_real']:.4f}  prior samples {row['prior_samples']:.4f}"
           f" ({row['samples_ratio']:.2f}x)  latent paths {row['latent_paths']:.4f} ({row['paths_ratio']:.2f}x)"
           f"  [{row['n_train']} train / {row['n_held_out']} held out; {args.samples} samples;"

@@ -45,10 +45,13 @@ def run(args) -> int:
 
     from meshvae_lib.model.meshvae_model import load_model
     from meshvae_lib.geometry.collection_io import write_collection
+    from meshvae_lib.validation import check_positive
 
     check_at_least(args.n, 1, "-n")
-    if not args.temperature > 0 or args.temperature == float("inf"):
-        raise UsageError(f"--temperature must be a finite number > 0, got {args.temperature}")
+    try:
+        check_positive(args.temperature, "--temperature")
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     model = load_model(args.model)
     condition = dict(args.condition)
     if condition and not model.is_conditional:

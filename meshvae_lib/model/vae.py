@@ -181,7 +181,8 @@ class MeshVAE(nn.Module):
         """A network without internal layers whose decoded means start as the training rows' PCA.
 
         x : (N, K) float32 normalised training rows (N >= 2); config : the latent size
-        (``config.resolved_latent_dim(N)``), alpha and sigma_floor come from it (``config.hidden`` must be empty, ``config.output`` "tanh"). The
+        (``config.resolved_latent_dim(N)``), alpha and sigma_floor come from it (``config.hidden``
+        must be empty, ``config.output`` "tanh"). The
         input projection, encoder and decoder start as :func:`~meshvae_lib.model.pca_start.pca_start`
         says (the deviation is 1 in the latent dimensions beyond its rank, where the latent cost is
         then 0); condition inputs start with zero weights. Returns the network in train mode.
