@@ -106,6 +106,10 @@ PCA_INIT_RTOL = 1e-8
 #: coordinate PCA baseline (evaluation.CoordinatePCA): singular values below this fraction of the
 #: largest count as zero when the span of the training meshes is measured.
 PCA_RANK_RTOL = 1e-12
+#: a collection whose held-out meshes PCA on (aligned) coordinates reproduces below this fraction of
+#: their bounding-box diagonal is linear data: a learned model's error on it is a training residual,
+#: not a property of its representation (issue 24; meshvae_lib.paper.linear_floor).
+LINEAR_DATA_RTOL = 1e-4
 
 # --- mesh VAE: floors of the encoder's deviation ----------------------------------------------
 #: floor added to the encoder's deviation in the experiments' networks, so that log(sigma^2) in

@@ -15,6 +15,7 @@ import pytest
 from meshvae_lib import paper
 from meshvae_lib import tolerances as tol
 from meshvae_lib.paper import protocol
+from meshvae_lib.paper.linear_floor import FLOOR_COLUMNS, NOT_INFORMATIVE, linear_floor
 from meshvae_lib.paper.robustness import density_resolutions
 
 
@@ -88,7 +89,7 @@ def test_load_collection_thins_evenly(coll):
 
 def test_latent_size_table(coll, cache):
     t = paper.latent_size_table([coll], latent_dims=(2, 8), settings=SETTINGS, cache=cache)
-    assert t.columns == ["collection [N]", "ours D=2", "ours D=8", "paper D=2", "paper D=8"]
+    assert t.columns == ["collection [N]", "ours D=2", "ours D=8", *FLOOR_COLUMNS, "paper D=2", "paper D=8"]
     assert len(t.rows) == 1 and t.rows[0][0] == "ellipsoids [40]"
     errs = t.data["errors"]["ellipsoids"]
     assert len(errs) == 2 and _finite_positive(errs)
@@ -123,7 +124,19 @@ def test_feature_table(coll, cache):
     row = t.as_dicts()[0]
     assert row["RIMD vs coords"] == f"{100 * (1 - errs['rimd'] / errs['coords']):.0f}%"
     assert row["paper rimd"] is None  # no paper number for this collection
-    assert t.plot().axes
+    # the linear floor: PCA on the same split, with the same error, in the row and in data
+    from meshvae_lib.model.evaluation import pca_baseline
+    from meshvae_lib.model.training import holdout_mask
+
+    d = paper.load_collection(coll, SETTINGS, cache=cache)
+    held = holdout_mask(len(d.vertices), SETTINGS.holdout_every)
+    pca = pca_baseline(d.vertices[~held], d.vertices[held])
+    assert row["PCA coords"] == pytest.approx(pca["mean_vertex_error"], rel=1e-12)
+    assert t.data["linear_floor"]["ellipsoids"] == linear_floor(d.vertices, SETTINGS.holdout_every)
+    assert row["informative"] == ("yes" if row["floor / diagonal"] >= tol.LINEAR_DATA_RTOL else NOT_INFORMATIVE)
+    fig = t.plot()
+    heights = [p.get_height() for p in fig.axes[0].patches]
+    assert heights[-2:] == [row["PCA coords"], row["PCA aligned"]]  # the floor's bars are drawn
 
 
 def test_robustness_table_reference_and_density(cache):
@@ -133,7 +146,11 @@ def test_robustness_table_reference_and_density(cache):
     assert runs[2]["reference"] == 3  # index 4 is held out (every 5th): moved to the previous mesh
     assert _finite_positive([r["error"] for r in runs])
     assert t.data["spread"] == pytest.approx(max(r["error"] for r in runs) - min(r["error"] for r in runs))
-    assert t.rows[0][5] == "No. 1" and t.rows[0][7] == pytest.approx(2.77e-4)
+    first = t.as_dicts()[0]
+    assert first["paper base"] == "No. 1" and first["paper error"] == pytest.approx(2.77e-4)
+    # every run shows its own collection's floor (the density changes the data, the reference does not)
+    assert [r["PCA coords"] for r in t.as_dicts()] == [r["linear_floor"]["pca_coords"] for r in runs]
+    assert runs[0]["linear_floor"] == runs[2]["linear_floor"] != runs[1]["linear_floor"]
 
 
 def test_density_resolutions_stay_inside_data_synth_limits():
@@ -149,7 +166,8 @@ def test_density_resolutions_stay_inside_data_synth_limits():
 
 def test_loss_table(coll, cache):
     t = paper.loss_table(coll, epoch_factor=2, settings=SETTINGS, cache=cache)
-    assert len(t.rows) == 2
+    assert len(t.rows) == 4 and t.column("loss")[2:] == ["PCA on coordinates (linear floor)", "PCA on aligned coordinates"]
+    assert t.rows[2][-1] == t.data["linear_floor"]["pca_coords"] and t.rows[3][-1] == t.data["linear_floor"]["pca_aligned"]
     mse_epochs, bce_epochs = t.rows[0][1], t.rows[1][1]
     assert bce_epochs == 2 * mse_epochs == len(t.data["bce_history"])
     assert _finite_positive([t.data["mse_error"], t.data["bce_error"]])
@@ -246,8 +264,9 @@ def test_plots_show_what_the_tables_print(coll, cache):
     t = paper.latent_size_table([coll], latent_dims=(2, 8), settings=SETTINGS, cache=cache)
     ax = t.plot().axes[0]
     assert ax.get_ylabel() == "held-out per-vertex error (mesh units)" and ax.get_yscale() == "log"
-    (line,) = ax.get_lines()
+    line, floor = ax.get_lines()
     np.testing.assert_array_equal(line.get_ydata(), t.rows[0][1:3])
+    assert list(floor.get_ydata()) == [t.as_dicts()[0]["PCA coords"]] * 2 and floor.get_linestyle() == "--"
     bare = paper.ExperimentTable(t.name, t.title, t.columns, t.rows)
     assert bare.plot().axes[0].get_lines()[0].get_ydata().tolist() == t.rows[0][1:3]
     t3 = paper.ExperimentTable("table3_robustness", "t3", ["base mesh", "points", "error", "paper error"],

@@ -23,7 +23,8 @@ function                      module                experiment
 The other modules: ``settings`` (:class:`ExperimentSettings`, the paper's numbers ``PAPER``),
 ``tables`` (:class:`ExperimentTable`, :func:`read_results`, :func:`definition_fingerprint`),
 ``protocol`` (:func:`load_collection`, the one way the experiments train a model, the held-out
-error, the cache) and ``plots``.
+error, the cache), ``linear_floor`` (:func:`linear_floor`: PCA on coordinates and on aligned
+coordinates under every error table, and whether a row is informative) and ``plots``.
 
 Every function takes ``settings`` (an :class:`ExperimentSettings`) or ``quick=True`` for the tiny
 preset a notebook runs in well under a minute, and a ``cache`` dict shared between experiments so
@@ -41,6 +42,7 @@ from meshvae_lib.paper.features import feature_table
 from meshvae_lib.paper.generation import generation_table
 from meshvae_lib.paper.interpolation import interpolation_table
 from meshvae_lib.paper.latent_size import latent_size_table
+from meshvae_lib.paper.linear_floor import informative_rows, linear_floor
 from meshvae_lib.paper.loss import loss_table
 from meshvae_lib.paper.protocol import collection_fingerprint, load_collection
 from meshvae_lib.paper.robustness import robustness_table
@@ -53,6 +55,8 @@ __all__ = [
     "PAPER",
     "collection_fingerprint",
     "load_collection",
+    "linear_floor",
+    "informative_rows",
     "latent_size_table",
     "feature_table",
     "robustness_table",

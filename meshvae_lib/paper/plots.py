@@ -50,36 +50,55 @@ def _bar_panels(table, panels, width=6.4, height=4.0, ticks=None):
     return fig
 
 
+def _row_ticks(table) -> list[str]:
+    """Each row's first cell, with "(linear data)" under it where the row is not informative."""
+    rows = table.as_dicts()
+    return [str(r[table.columns[0]]) + ("\n(linear data)" if r.get("informative", "yes") != "yes" else "")
+            for r in rows]
+
+
 def plot_latent_size(table):
-    """Table 1: the held-out error (as the table prints it) against the latent size, one line per collection."""
+    """Table 1: the held-out error (as the table prints it) against the latent size, one line per
+    collection, and its linear floor (PCA on coordinates) as a dashed line of the same colour."""
     fig = _figure()
     ax = fig.add_subplot(111)
     cols = [c for c in table.columns if c.startswith("ours D=")]
     dims = [int(c.split("=")[1]) for c in cols]
-    for row in table.as_dicts():
-        ax.plot(dims, [row[c] for c in cols], "o-", label=f"{row['collection [N]']} (ours)")
+    for row, tick in zip(table.as_dicts(), _row_ticks(table)):
+        name = tick.replace("\n", " ")
+        line, = ax.plot(dims, [row[c] for c in cols], "o-", label=f"{name} (ours)")
+        if row.get("PCA coords") is not None:
+            ax.axhline(row["PCA coords"], color=line.get_color(), ls="--", lw=1,
+                       label=f"{name}: PCA on coordinates (linear floor)")
     ax.set_xscale("log", base=2)
     ax.set_xticks(dims)
     ax.set_xticklabels([str(d) for d in dims])
     ax.set_yscale("log")
     ax.set_xlabel("latent dimension")
     ax.set_ylabel(ERROR_LABEL)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     ax.set_title(table.title, fontsize=9)
     return fig
 
 
 def plot_features(table):
-    """Table 2: our held-out error per collection and input feature."""
+    """Table 2: our held-out error per collection and input feature, beside the linear floor (PCA on
+    coordinates and on aligned coordinates); rows on linear data say so under their name."""
     cols = [c for c in table.columns if c.startswith("ours ")]
-    return _bar_panels(table, [(cols, ERROR_LABEL, {"labels": [c[5:] for c in cols], "log": True})], width=7.5)
+    floors = [c for c in ("PCA coords", "PCA aligned") if c in table.columns]
+    labels = [c[5:] for c in cols] + [f"{c} (linear floor)" for c in floors]
+    return _bar_panels(table, [(cols + floors, ERROR_LABEL, {"labels": labels, "log": True})], width=8.5,
+                       ticks=_row_ticks(table))
 
 
 def plot_robustness(table):
-    """Table 3: our held-out error per reference mesh and density, beside the paper's (Dyna)."""
+    """Table 3: our held-out error per reference mesh and density, beside the linear floor (PCA on
+    coordinates) and the paper's (Dyna)."""
     ticks = [f"{r['base mesh']}, {r['points']} pts" for r in table.as_dicts()]
-    return _bar_panels(table, [(["error", "paper error"], ERROR_LABEL,
-                                {"labels": ["ours", "paper (Dyna chicken wings)"], "log": True})], ticks=ticks)
+    floors = [c for c in ("PCA coords",) if c in table.columns]
+    return _bar_panels(table, [(["error", *floors, "paper error"], ERROR_LABEL,
+                                {"labels": ["ours", *(f"{c} (linear floor)" for c in floors),
+                                            "paper (Dyna chicken wings)"], "log": True})], ticks=ticks)
 
 
 def plot_generation(table):

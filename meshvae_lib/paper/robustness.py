@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from meshvae_lib.model.evaluation import evaluate_model
+from meshvae_lib.paper.linear_floor import FLOOR_COLUMNS, floor_cells, linear_floor
 from meshvae_lib.paper.protocol import load_collection, name_of, safe_reference, timed, train_model
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
@@ -34,13 +35,14 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     The first reference is trained at every resolution (default: 0.8x, 1x and 1.25x the
     settings' resolution, the paper's 6002 / 6890 / 8002 points); the others at the settings'
     resolution. Reference indices are 0-based (the paper's No. 1, 6, 72) and are moved off
-    held-out meshes if needed.
+    held-out meshes if needed. Every row also shows the linear floor of its collection
+    (:mod:`.linear_floor`; it depends on the density, not on the reference).
     """
     s = resolve_settings(settings, quick)
     if resolutions is None:
         resolutions = density_resolutions(s.resolution or 600)
     resolutions = [int(r) for r in resolutions]
-    cols = ["base mesh", "points (asked)", "points", "error", "relative error", "paper base", "paper points",
+    cols = ["base mesh", "points (asked)", "points", "error", "relative error", *FLOOR_COLUMNS, "paper base", "paper points",
             "paper error"]
     table = ExperimentTable("table3_robustness", "Table 3: held-out error vs reference mesh and mesh density", cols)
     runs = [(references[0], r) for r in resolutions] + [(ref, resolutions[0]) for ref in references[1:]]
@@ -49,11 +51,13 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
         coll = load_collection(collection, s, resolution=res, cache=cache)
         r = safe_reference(ref, len(coll.vertices), s.holdout_every)
         ev = evaluate_model(train_model(coll, s, cache, reference_index=r), coll, held_out_only=True, inference="encoder")
+        floor = linear_floor(coll.vertices, s.holdout_every)
         paper = PAPER["table3"][i] if i < len(PAPER["table3"]) else (None, None, None)
         table.rows.append([f"No. {r + 1}", res, coll.vertices.shape[1], ev["mean_vertex_error"], ev["relative_error"],
-                           paper[0], paper[1], None if paper[2] is None else paper[2] * 1e-4])
+                           *floor_cells(floor), paper[0], paper[1], None if paper[2] is None else paper[2] * 1e-4])
         table.data["runs"].append({"reference": r, "resolution": res, "n_vertices": coll.vertices.shape[1],
-                                   "error": ev["mean_vertex_error"], "relative": ev["relative_error"]})
+                                   "error": ev["mean_vertex_error"], "relative": ev["relative_error"],
+                                   "linear_floor": floor})
     errs = [run["error"] for run in table.data["runs"]]
     table.data["spread"] = float(max(errs) - min(errs))
     table.notes.append(f"collection {name_of(collection)!r}; spread of our errors (max - min): {table.data['spread']:.3e}"
