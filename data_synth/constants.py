@@ -40,6 +40,16 @@ MAX_FOLD_ANGLE_DEG = 150.0
 MAX_TEMPLATE_FOLD_DEG = 140.0
 #: smallest interior angle (degrees) of any template triangle.
 MIN_TEMPLATE_ANGLE_DEG = 10.0
+#: two meshes are the same mesh when every vertex lies within this fraction of the bounding-box
+#: diagonal of its counterpart (quality.duplicate_pairs).
+DUPLICATE_MESH_RTOL = 1e-6
+#: the linear floor a stand-in collection must reach (issue 24; benchmarks/bench_synth_floor.py): PCA
+#: on coordinates, every direction the training meshes span, every 5th mesh held out, at least this
+#: fraction of the bounding-box diagonal; the pose collections at least POSE_FLOOR_TARGET (a real
+#: scanned body in 71 poses: 8e-3).
+FLOOR_TARGET = 1e-4
+POSE_FLOOR_TARGET = 2e-3
+POSE_COLLECTIONS = ("scape", "dyna", "hand", "face")
 
 # --- humanoid ---------------------------------------------------------------------------------
 #: default and allowed vertex counts of the body template.
