@@ -111,7 +111,7 @@ def _jsonable(table) -> dict:
             "notes": table.notes, "seconds": table.seconds}
 
 
-def _write_summary(out, args, settings, total, parts, results, failed, done: bool) -> None:
+def _write_summary(out, args, settings, total, parts, results, failed, done: bool, provenance: dict) -> None:
     """summary.md and results.json (rewritten after every experiment, so a cut run keeps its tables)."""
     state = "" if done else " (in progress)"
     header = (f"# Experiments ({'quick' if args.quick else 'full'} size){state}\n\n"
@@ -119,12 +119,14 @@ def _write_summary(out, args, settings, total, parts, results, failed, done: boo
               f"Settings: `{dataclasses.asdict(settings)}`\n\n")
     (out / "summary.md").write_text(header + "\n".join(parts))
     (out / "results.json").write_text(json.dumps({"settings": dataclasses.asdict(settings), "seconds": total,
-                                                  "done": done, "failed": failed, "provenance": _provenance(args, settings),
+                                                  "done": done, "failed": failed, "provenance": provenance,
                                                   "tables": results}, indent=1))
 
 
 def _provenance(args, settings) -> dict:
-    """What the numbers depend on: the experiments' definitions, the commit, versions, the machine."""
+    """What the numbers depend on: the experiments' definitions, the commit, versions, the machine.
+    Taken before the first table is written: the run's own outputs (into a tracked folder such as
+    docs/results) must not count as uncommitted changes of the source."""
     import platform
 
     import scipy
@@ -160,6 +162,7 @@ def main(argv=None) -> int:
     if unknown:
         p.error(f"unknown experiments {unknown}; choose from {list(SHORT)}")
     cache: dict = {}
+    provenance = _provenance(args, settings)
     results, failed, parts = {}, [], []
     t_all = time.perf_counter()
     for key in chosen:
@@ -186,9 +189,9 @@ def main(argv=None) -> int:
         parts.append(f"## {key}\n\n{md}\n\n" + "".join(f"![{f}]({f})\n" for f in files))
         print(md, flush=True)
         print(f"   ({table.seconds:.0f} s)", flush=True)
-        _write_summary(out, args, settings, time.perf_counter() - t_all, parts, results, failed, done=False)
+        _write_summary(out, args, settings, time.perf_counter() - t_all, parts, results, failed, done=False, provenance=provenance)
     total = time.perf_counter() - t_all
-    _write_summary(out, args, settings, total, parts, results, failed, done=True)
+    _write_summary(out, args, settings, total, parts, results, failed, done=True, provenance=provenance)
     print(f"wrote {out}/summary.md ({total:.0f} s); failed: {failed or 'none'}", flush=True)
     return 1 if failed else 0
 

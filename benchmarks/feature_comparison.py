@@ -10,7 +10,10 @@ stopping chose and the encoding time per held-out mesh. Every model is evaluated
 inference strategy of ``--inference`` (default: the library's default, Gauss-Newton from the
 encoder's means with the analytic Jacobian, and the paper's feed-forward encoder); with
 ``--fit-latent N`` also with codes fitted by finite differences (the "finite-difference" inference). Two linear rows close each table: PCA on coordinates and on aligned coordinates,
-fitted on the training meshes with every direction they span (``evaluation.pca_baseline``).
+fitted on the training meshes with every direction they span (``evaluation.pca_baseline``), then the
+linear floor as a fraction of the diagonal (``paper.linear_floor``): below 1e-4 the collection is
+linear data and its learned rows say nothing about a representation. A run on the real collections
+prints what their README asks to cite.
 
 Collections: the real ones in ``../shared/data`` (``samba``, ``pdance``, ``pcow``; not part of the
 repository) when that folder exists, else a ``data_synth`` collection. By default it trains with the
@@ -39,11 +42,16 @@ import torch
 
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
+from meshvae_lib.paper.linear_floor import NOT_INFORMATIVE, linear_floor
 from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import holdout_mask
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+#: what ../shared/data/README.md asks to cite wherever a result on its collections is shown.
+REAL_CITATIONS = ("Sumner & Popović, 'Deformation Transfer for Triangle Meshes' (SIGGRAPH 2004)",
+                  "Vlasic, Baran, Matusik, Popović, 'Articulated Mesh Animation from Multi-view Silhouettes' (SIGGRAPH 2008)",
+                  "Briceño et al., 'Geometry Videos' (SCA 2003)")
 REAL = ("samba", "pdance", "pcow")
 KINDS = ("coords", "aligned", "rimd")
 
@@ -124,6 +132,13 @@ def run_collection(coll, name: str, args) -> list[dict]:
         print(f"{label:26s} {row['K']:7d} {row['train_error']:12.4e} {row['held_out_error']:10.4e}"
               f" {100 * row['relative_error']:7.3f} {'':>6s} {row['seconds']:9.1f}   ({res['n_components']} components)",
               flush=True)
+    floor = linear_floor(V, args.holdout_every)
+    next(r for r in rows if r["features"] == "PCA coords").update(floor_relative=floor["relative"],
+                                                                   informative=floor["informative"])
+    print(f"linear floor: {floor['relative']:.2e} of the diagonal"
+          + ("" if floor["informative"] else f" ({NOT_INFORMATIVE}: a held-out mesh is a linear combination of training"
+                                             " meshes; no learned row here says anything about a representation)"),
+          flush=True)
     err = {r["features"]: r["held_out_error"] for r in rows}
     if all(k in err for k in KINDS):
         r, a, c, p = err["rimd"], err["aligned"], err["coords"], err["PCA coords"]
@@ -166,6 +181,7 @@ def main() -> None:
     names = args.real.split(",") if args.real else ([] if args.synth else
                                                       [n for n in REAL if (SHARED_DATA / f"{n}.npz").exists()])
     if names:
+        print("data: " + "; ".join(REAL_CITATIONS), flush=True)
         for name in names:
             rows += run_collection(load_real(name, args.subsample), name + (f"/{args.subsample}" if args.subsample > 1 else ""),
                                    args)

@@ -49,3 +49,18 @@ def test_real_inference_table_prints_the_recorded_rows_and_their_ratio():
                                 "0.25", "|", "0.50"]
     assert lines[2].split() == ["b", "-", "1.00e+00", "3.00e+00", "1.50e+00", "4.00e+00", "|", "-", "0.67", "2.00",
                                 "|", "0.75"]
+
+
+def test_real_feature_table_prints_the_recorded_kinds_the_floor_and_the_verdict():
+    from meshvae_lib.course.display import real_feature_table
+
+    rows = [{"collection": "a/3", "coords_default": 0.03, "aligned_default": 0.02, "default": 0.01, "paper_path": 0.5,
+             "pca_coords": 0.04, "pca_aligned": 0.02, "floor_relative": 5e-3, "informative": True},
+            {"collection": "b", "coords_default": 2e-5, "aligned_default": 1.6e-5, "default": 7.5e-5, "paper_path": None,
+             "pca_coords": 1.5e-5, "pca_aligned": 1.2e-5, "floor_relative": 5.2e-6, "informative": False}]
+    lines = real_feature_table(rows).splitlines()
+    assert len(lines) == 3 and lines[0].split()[:4] == ["collection", "coords", "aligned", "RIMD"]
+    assert lines[1].split() == ["a/3", "3.00e-02", "2.00e-02", "1.00e-02", "5.00e-01", "4.00e-02", "2.00e-02", "5.0e-03",
+                                "0.25", "yes"]
+    assert lines[2].split() == ["b", "2.00e-05", "1.60e-05", "7.50e-05", "-", "1.50e-05", "1.20e-05", "5.2e-06", "5.00",
+                                "linear", "data:", "not", "informative"]

@@ -11,7 +11,7 @@ import numpy as np
 
 from meshvae_lib.tolerances import TIE_RTOL
 
-__all__ = ["roundoff", "first_argmax", "real_inference_table"]
+__all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table"]
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -64,4 +64,24 @@ def real_inference_table(rows) -> str:
                      f" {r['pca_coords']:10.2e} {r['pca_aligned']:9.2e} | {paper_ratio:>15s}"
                      f" {r['encoder'] / r['pca_coords']:8.2f} {r['default'] / r['pca_coords']:8.2f}"
                      f" | {r['default'] / r['pca_aligned']:8.2f}")
+    return "\n".join(lines)
+
+
+def real_feature_table(rows) -> str:
+    """Table 2 on real meshes, recorded (``docs/results/inference_real.json``'s ``rows``: dicts with
+    ``collection``, ``coords_default``, ``aligned_default``, ``default`` (RIMD), ``paper_path`` (RIMD
+    the paper's way, or None), ``pca_coords``, ``pca_aligned``, ``floor_relative`` and ``informative``)
+    as a fixed-width table: the three input kinds with the library's default training and inference,
+    RIMD the paper's way, the linear floor, the floor over the diagonal, RIMD (default) over PCA on
+    coordinates, and "yes" or "linear data: not informative". Recorded numbers, the same on every
+    machine."""
+    from meshvae_lib.paper.linear_floor import NOT_INFORMATIVE
+
+    lines = [f"{'collection':10s} {'coords':>9s} {'aligned':>9s} {'RIMD':>9s} {'RIMD paper':>10s} {'PCA coords':>10s}"
+             f" {'PCA align':>9s} {'floor/diag':>10s} {'RIMD/PCA':>8s}  informative"]
+    for r in rows:
+        paper = "-" if r.get("paper_path") is None else f"{r['paper_path']:.2e}"
+        lines.append(f"{r['collection']:10s} {r['coords_default']:9.2e} {r['aligned_default']:9.2e} {r['default']:9.2e}"
+                     f" {paper:>10s} {r['pca_coords']:10.2e} {r['pca_aligned']:9.2e} {r['floor_relative']:10.1e}"
+                     f" {r['default'] / r['pca_coords']:8.2f}  {'yes' if r['informative'] else NOT_INFORMATIVE}")
     return "\n".join(lines)

@@ -87,8 +87,10 @@ def plot_features(table):
     cols = [c for c in table.columns if c.startswith("ours ")]
     floors = [c for c in ("PCA coords", "PCA aligned") if c in table.columns]
     labels = [c[5:] for c in cols] + [f"{c} (linear floor)" for c in floors]
-    return _bar_panels(table, [(cols + floors, ERROR_LABEL, {"labels": labels, "log": True})], width=8.5,
-                       ticks=_row_ticks(table))
+    fig = _bar_panels(table, [(cols + floors, ERROR_LABEL, {"labels": labels, "log": True})], width=9.5,
+                      ticks=_row_ticks(table))
+    fig.axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))  # beside the bars, not over them
+    return fig
 
 
 def plot_robustness(table):
