@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/experiments.py --out build/experiments [--quick] [--only table1,embedding]
 
-``make experiments`` runs it at full size (about 30 minutes on two CPU cores) into ``docs/results``, whose
+``make experiments`` runs it at full size (3 to 30 minutes on two CPU cores, depending on the machine) into ``docs/results``, whose
 tables are committed: notebook 09 shows them, and a test fails when the experiments change after they
 were recorded (``results.json`` holds the definitions' fingerprint, the commit, the package versions,
 the machine and the run time). Writes, in ``--out``:
