@@ -76,6 +76,15 @@ DYNA_FRAMES_PER_MOTION = 6
 HAND_DEFAULT_RESOLUTION = 1800
 HAND_BLEND_RADIUS = 0.006
 HAND_SKIN_BLEND_WIDTH = 0.016
+#: the hand collection: meshes per gesture, each an independent draw around the gesture's pose: its
+#: curls scaled by U(HAND_MIN_AMOUNT, 1), every joint moved by up to HAND_JOINT_JITTER of its range,
+#: the spread by up to HAND_SPREAD_JITTER, and the wrist's flexion, deviation and pronation by up
+#: to HAND_WRIST_RANGE radians (small enough for every gesture to stay recognisable)
+HAND_VARIANTS = 10
+HAND_MIN_AMOUNT = 0.85
+HAND_JOINT_JITTER = 0.15
+HAND_SPREAD_JITTER = 0.3
+HAND_WRIST_RANGE = (0.4, 0.25, 0.6)
 #: the flag's pole (scenery for renderings, not part of the mesh): radius, bottom and top, in the
 #: flag's units (the sheet is 1 high, from y = 0 to 1)
 FLAG_POLE_RADIUS = 0.02
@@ -93,9 +102,20 @@ FACE_BLEND_RADIUS = 0.02
 FLAG_DEFAULT_RESOLUTION = 1200
 FLAG_ASPECT = 1.5
 FLAG_N_FRAMES = 100
+#: frames per second of the flag, its wind's travelling waves, their total amplitude (radians of yaw
+#: at the free end, before the gust) and their shortest wavelength (in the sheet's height)
+FLAG_FPS = 8.0
+FLAG_WIND_MODES = 24
+FLAG_WAVE_AMPLITUDE = 1.6
+FLAG_MIN_WAVELENGTH = 0.3
 BAR_DEFAULT_RESOLUTION = 1000
 BAR_LENGTH = 4.0
 BAR_RADIUS = 0.35
 #: exponent of the bar's superellipse cross section (2: circle; larger: squarer).
 BAR_SQUARENESS = 4.0
 BAR_N_FRAMES_PER_MOTION = 20
+#: spread (standard deviation, degrees) of the bar's profile modes: rows twist, bend (in each of the
+#: two planes); columns the constant, linear and quadratic mode along the bar
+BAR_PROFILE_DEG = ((150.0, 120.0, 60.0), (100.0, 80.0, 40.0))
+#: the draws are clipped at this many standard deviations (a larger bend can loop the tube into itself)
+BAR_PROFILE_CLIP = 1.6

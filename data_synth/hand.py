@@ -4,7 +4,8 @@ Coordinates (metres): the wrist at the origin, fingers pointing along +y, the pa
 the thumb on the +x side. Built like the body: an implicit model (ellipsoid palm, tapered-capsule
 phalanges and a forearm stump), polygonised, skinned to a 17-joint skeleton and posed with
 dual-quaternion skinning. Gestures curl the fingers (flexion about each joint's axis) and bend
-the wrist.
+the wrist; every mesh draws its own angles for every joint around its gesture's, so that no two
+meshes share a pose and the collection is not a linear family (benchmarks/bench_synth_floor.py).
 """
 
 from __future__ import annotations
@@ -19,22 +20,26 @@ from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 from data_synth.skeleton import Skeleton, axis_rotation, forward_kinematics
 from data_synth.skinning import dual_quaternion_blend, skinning_weights
 
-__all__ = ["make_hand", "hand_template", "GESTURES", "FINGERS"]
+__all__ = ["make_hand", "hand_template", "GESTURES", "FINGERS", "STEADY_FINGERS"]
 
 FINGERS = ("thumb", "index", "middle", "ring", "little")
 _X, _Y, _Z = np.eye(3)
 
-#: gesture -> curl per finger (0 straight, 1 fully curled), thumb first; then spread, wrist flex
+#: gesture -> curl per finger (0 straight, 1 fully curled), thumb first; then spread; then the
+#: wrist's flexion, deviation and pronation (radians; thumbs up turns the fist on its side)
 GESTURES = {
-    "fist": ((1.0, 1.0, 1.0, 1.0, 1.0), 0.0, 0.2),
-    "point": ((0.9, 0.0, 1.0, 1.0, 1.0), 0.0, 0.0),
-    "peace": ((0.9, 0.0, 0.0, 1.0, 1.0), 0.6, 0.0),
-    "thumbs_up": ((0.0, 1.0, 1.0, 1.0, 1.0), 0.0, -0.3),
-    "grab": ((0.5, 0.55, 0.55, 0.55, 0.55), 0.3, 0.3),
-    "spread": ((0.0, 0.0, 0.0, 0.0, 0.0), 1.0, -0.4),
-    "ok": ((0.65, 0.7, 0.1, 0.15, 0.2), 0.3, 0.0),
-    "wave_down": ((0.1, 0.1, 0.1, 0.1, 0.1), 0.2, 1.1),
+    "fist": ((1.0, 1.0, 1.0, 1.0, 1.0), 0.0, (0.2, 0.0, 0.0)),
+    "point": ((0.9, 0.0, 1.0, 1.0, 1.0), 0.0, (0.0, 0.0, 0.0)),
+    "peace": ((0.9, 0.0, 0.0, 1.0, 1.0), 0.6, (0.0, 0.0, 0.0)),
+    "thumbs_up": ((0.0, 1.0, 1.0, 1.0, 1.0), 0.0, (0.0, 0.75, 0.0)),
+    "grab": ((0.5, 0.55, 0.55, 0.55, 0.55), 0.3, (0.3, 0.0, 0.0)),
+    "spread": ((0.0, 0.0, 0.0, 0.0, 0.0), 1.0, (-0.4, 0.0, 0.0)),
+    "ok": ((0.4, 0.75, 0.1, 0.15, 0.2), 0.3, (0.0, 0.0, 0.0)),
+    "wave_down": ((0.1, 0.1, 0.1, 0.1, 0.1), 0.2, (0.75, 0.0, 0.0)),
 }
+#: gesture -> fingers that hold their pose exactly (no per-mesh jitter): the ring of "ok", whose
+#: thumb and index tips nearly touch (1.8 cm apart centre to centre, about 4 mm of skin between)
+STEADY_FINGERS = {"ok": ("thumb", "index")}
 
 
 def _layout():
@@ -107,11 +112,17 @@ def hand_template(resolution: int | None = None):
     return _cached(resolution)
 
 
-def _gesture_rotations(skeleton, dirs, curls, spread, wrist, amount) -> np.ndarray:
-    """Local rotations ``(n_frames, 17, 3, 3)`` blending from open (0) to the gesture (1)."""
-    n = len(amount)
+def _pose_rotations(skeleton, dirs, joint_curl, spread, wrist) -> np.ndarray:
+    """Local rotations ``(n, 17, 3, 3)`` of ``n`` hand poses.
+
+    joint_curl : (n, 5, 3) float, flexion of every finger joint (thumb first) as a fraction of its
+        range (0 straight, 1 fully bent); spread : (n,) float, how far the fingers fan out (0: the
+        rest splay, 1: spread); wrist : (n, 3) float, radians: flexion (about x), deviation (about z)
+        and pronation (a twist about the forearm, y).
+    """
+    n = len(spread)
     local = np.broadcast_to(np.eye(3), (n, skeleton.n_joints, 3, 3)).copy()
-    local[:, 1] = axis_rotation(_X, wrist * amount)
+    local[:, 1] = axis_rotation(_Y, wrist[:, 2]) @ axis_rotation(_Z, wrist[:, 1]) @ axis_rotation(_X, wrist[:, 0])
     flex = (1.25, 1.45, 0.95)  # maximum flexion of the three joints, radians
     spread_angle = {"index": 0.12, "middle": 0.0, "ring": -0.1, "little": -0.22, "thumb": 0.3}
     thumb_target = np.array([-0.7, 0.0, 1.0])
@@ -119,40 +130,53 @@ def _gesture_rotations(skeleton, dirs, curls, spread, wrist, amount) -> np.ndarr
         for k in range(3):
             j = skeleton.index(f"{finger}_{k}")
             if finger == "thumb":
-                axis = np.cross(dirs[j], thumb_target)
-                angle = curls[f] * amount * (0.7, 0.8, 0.9)[k]
+                axis, angle = np.cross(dirs[j], thumb_target), joint_curl[:, f, k] * (0.7, 0.8, 0.9)[k]
             else:
-                axis = _X
-                angle = curls[f] * amount * flex[k]
+                axis, angle = _X, joint_curl[:, f, k] * flex[k]
             R = axis_rotation(axis, angle)
             if k == 0:
-                R = R @ axis_rotation(_Z, -spread * spread_angle[finger] * amount)
+                R = R @ axis_rotation(_Z, -spread * spread_angle[finger])
             local[:, j] = R
     return local
 
 
+def _sample_poses(rng, curls, spread, wrist, n: int, steady=()):
+    """``n`` independent variants of one gesture: every joint, the spread and all three wrist angles
+    drawn around the gesture's (``constants.HAND_*``), so that no two meshes share a pose; the
+    fingers named in ``steady`` keep the gesture's curls exactly."""
+    amount = np.broadcast_to(rng.uniform(C.HAND_MIN_AMOUNT, 1.0, size=(n, 1, 1)), (n, 5, 1)).copy()
+    jitter = rng.uniform(-1, 1, size=(n, 5, 3)) * C.HAND_JOINT_JITTER
+    for finger in steady:
+        amount[:, FINGERS.index(finger)] = 1.0
+        jitter[:, FINGERS.index(finger)] = 0.0
+    joint = np.asarray(curls, float)[None, :, None] * amount + jitter
+    spread_jitter = 0.0 if steady else C.HAND_SPREAD_JITTER  # the spread moves the thumb and the index
+    spread = np.clip(spread + rng.uniform(-1, 1, size=n) * spread_jitter, 0.0, 1.2)
+    wrist = np.asarray(wrist, float)[None] + rng.uniform(-1, 1, size=(n, 3)) * np.asarray(C.HAND_WRIST_RANGE)
+    return np.clip(joint, 0.0, 1.0), spread, wrist
+
+
 def make_hand(seed: int = 0, resolution: int | None = None,
-              frames_per_gesture: int = 10) -> SynthCollection:
-    """Each gesture from the open hand to its peak; labels ``gesture``, ``frame``."""
+              variants_per_gesture: int = C.HAND_VARIANTS) -> SynthCollection:
+    """Every gesture, ``variants_per_gesture`` times, each an independent pose near the gesture's peak
+    (every finger joint, the spread and the wrist's three angles drawn per mesh); labels
+    ``gesture``, ``variant``."""
     V0, F, W, skeleton, dirs = hand_template(resolution)
     rng = np.random.default_rng(seed)
-    chunks, names, gesture, frame = [], [], [], []
-    ramp = np.linspace(0.0, 1.0, frames_per_gesture)
-    ramp = ramp * ramp * (3 - 2 * ramp)
+    chunks, names, gesture, variant = [], [], [], []
     for g, (curls, spread, wrist) in GESTURES.items():
-        curls = np.clip(np.array(curls) + rng.uniform(-0.08, 0.08, size=5), 0.0, 1.0)
-        local = _gesture_rotations(skeleton, dirs, curls, spread * rng.uniform(0.8, 1.1),
-                                   wrist + rng.uniform(-0.15, 0.15), ramp)
-        R, p = forward_kinematics(skeleton, local, np.zeros((len(ramp), 3)))
+        local = _pose_rotations(skeleton, dirs, *_sample_poses(rng, curls, spread, wrist, variants_per_gesture,
+                                                                       STEADY_FINGERS.get(g, ())))
+        R, p = forward_kinematics(skeleton, local, np.zeros((variants_per_gesture, 3)))
         t = p - np.einsum("njab,jb->nja", R, skeleton.rest)
         chunks.append(dual_quaternion_blend(np.asarray(V0), W, R, t, parents=skeleton.parents))
-        for f in range(frames_per_gesture):
-            names.append(f"{g}_{f:02d}")
+        for v in range(variants_per_gesture):
+            names.append(f"{g}_{v:02d}")
             gesture.append(g)
-            frame.append(f)
+            variant.append(v)
     return SynthCollection(
         vertices=np.concatenate(chunks), faces=np.array(F), names=names,
-        labels={"gesture": np.array(gesture), "frame": np.array(frame, dtype=np.int64)},
-        description="a hand making gestures from the open pose (fingers bend at three joints)",
+        labels={"gesture": np.array(gesture), "variant": np.array(variant, dtype=np.int64)},
+        description="a hand making gestures, every mesh its own pose of every finger joint and the wrist",
         extras={"rest": np.array(V0)},
     )

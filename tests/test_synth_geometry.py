@@ -1,5 +1,6 @@
 """Geometry of every synthetic collection: closed/manifold templates, no degenerate or inverted
-triangles in any frame, edge lengths within bounds of the rest pose, and the bar's twist."""
+triangles in any frame, edge lengths within bounds of the rest pose, no crossing triangles and no
+repeated meshes (where the collection is rebuilt already), and the bar's turning rings."""
 
 from __future__ import annotations
 
@@ -187,26 +188,35 @@ def _ring_rotations(col, frame):
     return Rotation.from_matrix(np.einsum("rij,rjk->rki", U, Vt))
 
 
-def test_bar_ends_rotate_past_180_degrees(collections):
+def test_bar_rings_turn_past_180_degrees_as_their_labels_say(collections):
+    """Every ring of the bar is its rest ring turned (a rod: sections keep their shape); the rotation
+    accumulated from ring to ring is the ``turn_deg`` label, and the most deformed mesh of every
+    motion turns past 180 degrees; a pure twist keeps the centre line straight and a pure bend keeps
+    the end rings untwisted about it."""
     col = collections["bar"]
+    n_along, n_around = col.extras["tube_shape"]
+    X0 = col.extras["rest"].reshape(n_along, n_around, 3)
     for motion in ("twist", "bend", "twist_bend"):
         idx = np.nonzero(col.labels["motion"] == motion)[0]
-        last = idx[np.argmax(col.labels["frame"][idx])]
+        last = idx[np.argmax(col.labels["turn_deg"][idx])]
         rings = _ring_rotations(col, last)
+        X = col.vertices[last].reshape(n_along, n_around, 3)
+        # each ring is a rigid copy of its rest ring (to round-off)
+        for r in (0, n_along // 2, n_along - 1):
+            moved = rings[r].apply(X0[r] - X0[r].mean(0)) + X[r].mean(0)
+            assert np.abs(moved - X[r]).max() < 1e-9, f"{motion}: ring {r} is not a rigid copy"
         steps = rings[1:] * rings[:-1].inv()  # ring to ring, each small
         step_angles = steps.magnitude()
         assert step_angles.max() < np.deg2rad(20)
         accumulated = np.rad2deg(step_angles.sum())
-        # the end-to-end rotation is the accumulated one modulo 360 degrees
-        end_to_end = np.rad2deg((rings[-1] * rings[0].inv()).magnitude())
-        expected = np.hypot(col.labels["twist_deg"][last], col.labels["bend_deg"][last])
-        assert accumulated > 180.0, f"{motion}: ends turned only {accumulated:.0f} deg"
-        if motion != "twist_bend":  # one fixed axis: the angles simply add up
-            assert abs(accumulated - expected) < 0.02 * expected
-            assert abs(min(accumulated % 360, 360 - accumulated % 360) - end_to_end) < 1.0
-        # the first frame is the straight, untwisted bar
-        first = idx[np.argmin(col.labels["frame"][idx])]
-        assert _ring_rotations(col, first).magnitude().max() < 1e-9
+        assert accumulated > 180.0, f"{motion}: rings turned only {accumulated:.0f} deg"
+        assert abs(accumulated - col.labels["turn_deg"][last]) < 0.01 * accumulated + 1
+        centre = X.mean(axis=1)
+        straight = np.linalg.norm(np.cross(centre - centre[0], centre[-1] - centre[0]), axis=1).max()
+        if motion == "twist":
+            assert straight < 1e-9 and col.labels["bend_deg"][last] == 0
+        if motion == "bend":
+            assert col.labels["twist_deg"][last] == 0 and straight > 0.1
 
 
 def test_flag_pole_is_scenery_along_the_attached_edge(collections):
@@ -233,3 +243,23 @@ def test_data_synth_normals_agree_with_the_library(collections):
         col = collections[name]
         V = col.vertices[0]
         np.testing.assert_allclose(vertex_normals(V, col.faces), library_normals(V, col.faces), atol=1e-12)
+
+
+#: collections not rebuilt yet for issue 24, and what they still hold (benchmarks/bench_synth_floor.py):
+#: crossing triangles (scape 2 meshes, dyna 41, jumping 12) and repeated meshes (dyna 50 pairs,
+#: jumping 60, face 28); strict, so that a rebuilt collection must leave this list
+NOT_REBUILT = {"scape", "dyna", "jumping", "face"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(n in NOT_REBUILT, strict=True,
+                                                                          reason="issue 24: not rebuilt yet"))
+                                  for n in NAMES])
+def test_no_crossing_triangles_and_no_repeated_meshes(collections, name):
+    from data_synth.quality import duplicate_pairs
+    from meshvae_lib.geometry.intersections import self_intersections
+
+    col = collections[name]
+    crossing = self_intersections(col.vertices, col.faces)
+    assert crossing.max() == 0, f"{name}: crossing triangles in {[col.names[i] for i in np.flatnonzero(crossing)]}"
+    pairs = duplicate_pairs(col.vertices)
+    assert len(pairs) == 0, f"{name}: {len(pairs)} pairs of identical meshes, e.g. {pairs[:3].tolist()}"

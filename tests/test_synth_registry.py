@@ -113,8 +113,9 @@ def test_group_labels_are_complete(name, column, groups):
     col = make_collection(name, resolution=SMALL)
     assert set(col.labels[column]) == groups
     counts = {g: int(np.sum(col.labels[column] == g)) for g in groups}
-    assert len(set(counts.values())) == 1, counts  # the same number of frames per group
-    for n, g, f in zip(col.names, col.labels[column], col.labels["frame"]):
+    assert len(set(counts.values())) == 1, counts  # the same number of meshes per group
+    index = "frame" if "frame" in col.labels else "variant"
+    for n, g, f in zip(col.names, col.labels[column], col.labels[index]):
         assert n == f"{g}_{f:02d}"
 
 
@@ -129,13 +130,16 @@ def test_face_intensity_grows_with_displacement():
 
 
 def test_sequences_are_smooth():
-    """Consecutive frames of the jumping sequence and the flag move much less than the whole
-    motion does (no jumps between frames)."""
-    for name in ("jumping", "flag"):
-        col = make_collection(name, resolution=SMALL)
-        step = np.abs(np.diff(col.vertices, axis=0)).max()
-        span = np.abs(col.vertices - col.vertices[0]).max()
-        assert step < 0.2 * span, f"{name}: a frame jumps by {step:.3f} of {span:.3f}"
+    """Consecutive frames of the jumping sequence move much less than the whole motion does (no
+    jumps between frames); the flag's frames are 1 / FLAG_FPS s apart in turbulent wind, far enough
+    for the folds to change, but consecutive frames are still nearer each other than frames far apart."""
+    col = make_collection("jumping", resolution=SMALL)
+    step = np.abs(np.diff(col.vertices, axis=0)).max()
+    span = np.abs(col.vertices - col.vertices[0]).max()
+    assert step < 0.2 * span, f"jumping: a frame jumps by {step:.3f} of {span:.3f}"
+    V = make_collection("flag", resolution=SMALL).vertices
+    gap = lambda lag: np.linalg.norm(V[lag:] - V[:-lag], axis=-1).mean()  # noqa: E731
+    assert gap(1) < 0.7 * gap(20), (gap(1), gap(20))
 
 
 def test_scape_poses_are_distinct():
