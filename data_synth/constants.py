@@ -96,6 +96,13 @@ FLAG_POLE_COLOR = "#7a6a58"
 FACE_BLENDSHAPE_SCALE = 1.7
 FACE_JAW_ANGLE = 0.34
 FACE_DEFAULT_RESOLUTION = 2000
+#: the face collection: meshes per expression, each drawing its intensity in [FACE_MIN_INTENSITY, 1],
+#: every blendshape weight within +-FACE_WEIGHT_JITTER of its share and an extra jaw opening of up to
+#: FACE_SPEECH_JAW radians (speech); the jaw never opens past FACE_JAW_ANGLE
+FACE_VARIANTS = 10
+FACE_MIN_INTENSITY = 0.6
+FACE_WEIGHT_JITTER = 0.2
+FACE_SPEECH_JAW = 0.06
 FACE_BLEND_RADIUS = 0.02
 
 # --- flag and bar -----------------------------------------------------------------------------

@@ -4,7 +4,8 @@ The neutral head is an implicit model (cranium, jaw, cheeks, nose, brow ridge, l
 and a neck stump; a mouth groove and eye sockets carved out), polygonised once. Each *blendshape*
 is a smooth displacement field of the neutral vertices (Gaussian-weighted moves of the mouth
 corners, brows, lips and cheeks, and a jaw rotation weighted below the mouth); an *expression* is a
-weighted sum of blendshapes, ramped from neutral to its peak.
+weighted sum of blendshapes with the jaw turned about its hinge (a rotation, not a scaled
+displacement); every mesh draws its own intensity and weights, so no two meshes are the same.
 
 Coordinates (metres): the head's centre near the origin, y up, the face looking along +z.
 """
@@ -14,6 +15,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from data_synth import constants as C
 from data_synth.collection import SynthCollection, resolve_resolution
@@ -81,6 +83,15 @@ def _smoothstep(x):
     return x * x * (3 - 2 * x)
 
 
+def _jaw_weights(V: np.ndarray):
+    """The jaw's hinge ``(3,)`` near the ears and each vertex's jaw weight ``(n,)``: everything below
+    the mouth, fading into the neck and towards the back of the head."""
+    front = _smoothstep((V[:, 2] - 0.03) / 0.04)
+    below = _smoothstep((-0.044 - V[:, 1]) / 0.03 + 0.35)
+    not_neck = _smoothstep((V[:, 2] - 0.0) / 0.05)
+    return np.array([0.0, -0.01, -0.02]), below * not_neck * front
+
+
 def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1."""
     x = V[:, 0]
@@ -108,11 +119,7 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     normals_out = V - np.array([0.0, -0.03, 0.0])
     normals_out /= np.linalg.norm(normals_out, axis=1, keepdims=True)
     out["cheek_puff"] = 0.01 * puff[:, None] * normals_out
-    # jaw: rotate everything below the mouth about a hinge near the ears, fading into the neck
-    pivot = np.array([0.0, -0.01, -0.02])
-    below = _smoothstep((-0.044 - V[:, 1]) / 0.03 + 0.35)
-    not_neck = _smoothstep((V[:, 2] - 0.0) / 0.05)
-    w = below * not_neck * front
+    pivot, w = _jaw_weights(V)
     out = {k: C.FACE_BLENDSHAPE_SCALE * d for k, d in out.items()}
     # pucker: the lips push forward (scaled like the others) and draw together sideways (not
     # scaled: more would crush the edges across the mouth)
@@ -134,31 +141,47 @@ def _identity(V: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return V
 
 
+def _jaw_rotation(V: np.ndarray, angle: float) -> np.ndarray:
+    """Open the jaw: every vertex turned about the hinge (near the ears) by ``angle`` times its jaw
+    weight (1 on the chin, fading to 0 above the mouth and into the neck): a rotation, not a
+    displacement scaled with the angle. V (n, 3) float64 -> (n, 3) float64."""
+    pivot, w = _jaw_weights(V)
+    rotvec = np.zeros((len(V), 3))
+    rotvec[:, 0] = angle * w
+    return Rotation.from_rotvec(rotvec).apply(V - pivot) + pivot
+
+
 def make_face(seed: int = 0, resolution: int | None = None,
-              frames_per_expression: int = 10) -> SynthCollection:
-    """Every expression ramped from neutral to its peak; labels ``expression``, ``frame``,
-    ``intensity_pct``."""
+              variants_per_expression: int = C.FACE_VARIANTS) -> SynthCollection:
+    """Every expression ``variants_per_expression`` times, each an independent draw: its intensity
+    (``FACE_MIN_INTENSITY`` to 1), every blendshape weight jittered by up to ``FACE_WEIGHT_JITTER``,
+    and the jaw opened by the expression's angle plus up to ``FACE_SPEECH_JAW`` radians (speech),
+    at most ``FACE_JAW_ANGLE``. Labels ``expression``, ``variant``, ``intensity_pct``."""
     V0, F = face_template(resolution)
     rng = np.random.default_rng(seed)
     V0 = _identity(np.array(V0), rng)
     shapes = blendshapes(V0)
-    ramp = np.linspace(0.0, 1.0, frames_per_expression)
-    ramp = ramp * ramp * (3 - 2 * ramp)
-    chunks, names, expr, frame, inten = [], [], [], [], []
+    chunks, names, expr, variant, inten = [], [], [], [], []
     for e, weights in EXPRESSIONS.items():
-        field = np.zeros_like(V0)
-        for b, w in weights.items():
-            field += w * rng.uniform(0.85, 1.1) * shapes[b]
-        chunks.append(V0[None] + ramp[:, None, None] * field[None])
-        for f in range(frames_per_expression):
-            names.append(f"{e}_{f:02d}")
+        for i in range(variants_per_expression):
+            intensity = rng.uniform(C.FACE_MIN_INTENSITY, 1.0)
+            field = np.zeros_like(V0)
+            jaw = rng.uniform(0.0, C.FACE_SPEECH_JAW)
+            for b, w in weights.items():
+                k = w * intensity * (1.0 + rng.uniform(-1, 1) * C.FACE_WEIGHT_JITTER)
+                if b == "jaw_open":
+                    jaw += k * C.FACE_JAW_ANGLE
+                else:
+                    field += k * shapes[b]
+            chunks.append(_jaw_rotation(V0 + field, min(jaw, C.FACE_JAW_ANGLE)))
+            names.append(f"{e}_{i:02d}")
             expr.append(e)
-            frame.append(f)
-            inten.append(int(round(100 * ramp[f])))
+            variant.append(i)
+            inten.append(int(round(100 * intensity)))
     return SynthCollection(
-        vertices=np.concatenate(chunks), faces=np.array(F), names=names,
-        labels={"expression": np.array(expr), "frame": np.array(frame, dtype=np.int64),
+        vertices=np.stack(chunks), faces=np.array(F), names=names,
+        labels={"expression": np.array(expr), "variant": np.array(variant, dtype=np.int64),
                 "intensity_pct": np.array(inten, dtype=np.int64)},
-        description="a head with blendshape expressions ramped from neutral to their peak",
+        description="a head with expressions (blendshapes and a rotating jaw), every mesh its own intensity",
         extras={"rest": V0, "blendshape_names": sorted(shapes)},  # rest: this seed's neutral
     )

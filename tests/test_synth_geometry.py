@@ -247,8 +247,8 @@ def test_data_synth_normals_agree_with_the_library(collections):
 
 #: collections not rebuilt yet for issue 24, and what they still hold (benchmarks/bench_synth_floor.py):
 #: crossing triangles (scape 2 meshes, dyna 41, jumping 12) and repeated meshes (dyna 50 pairs,
-#: jumping 60, face 28); strict, so that a rebuilt collection must leave this list
-NOT_REBUILT = {"scape", "dyna", "jumping", "face"}
+#: jumping 60); strict, so that a rebuilt collection must leave this list
+NOT_REBUILT = {"scape", "dyna", "jumping"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(n in NOT_REBUILT, strict=True,
