@@ -93,8 +93,8 @@ def _rest_tube(resolution: int):
 def make_bar(seed: int = 0, resolution: int | None = None,
              n_variants: int = C.BAR_N_FRAMES_PER_MOTION) -> SynthCollection:
     """Bar collection: 3 motions x ``n_variants`` independent draws; labels ``motion``, ``variant``,
-    ``twist_deg`` (the end rings' twist about the bar), ``bend_deg`` (the bending accumulated along
-    it) and ``turn_deg`` (all rotation accumulated from ring to ring)."""
+    ``twist_deg`` (the end rings' twist about the bar) and ``bend_deg`` (the bending accumulated
+    along it); ``extras["turn_deg"]`` (n,) int64: all rotation accumulated from ring to ring."""
     resolution = C.BAR_DEFAULT_RESOLUTION if resolution is None else int(resolution)
     V0, F, tube_shape = _rest_tube(resolution)
     rng = np.random.default_rng(seed)
@@ -119,8 +119,7 @@ def make_bar(seed: int = 0, resolution: int | None = None,
     return SynthCollection(
         vertices=np.concatenate(chunks), faces=F, names=names,
         labels={"motion": np.array(motion), "variant": np.array(variant, dtype=np.int64),
-                "twist_deg": np.array(tw, dtype=np.int64), "bend_deg": np.array(bd, dtype=np.int64),
-                "turn_deg": np.array(turns, dtype=np.int64)},
+                "twist_deg": np.array(tw, dtype=np.int64), "bend_deg": np.array(bd, dtype=np.int64)},
         description="an open tube (two boundary loops) bent and twisted along its length, past 180 degrees",
-        extras={"rest": V0, "tube_shape": tube_shape},
+        extras={"rest": V0, "tube_shape": tube_shape, "turn_deg": np.array(turns, dtype=np.int64)},
     )

@@ -190,7 +190,7 @@ def _ring_rotations(col, frame):
 
 def test_bar_rings_turn_past_180_degrees_as_their_labels_say(collections):
     """Every ring of the bar is its rest ring turned (a rod: sections keep their shape); the rotation
-    accumulated from ring to ring is the ``turn_deg`` label, and the most deformed mesh of every
+    accumulated from ring to ring is ``extras["turn_deg"]``, and the most deformed mesh of every
     motion turns past 180 degrees; a pure twist keeps the centre line straight and a pure bend keeps
     the end rings untwisted about it."""
     col = collections["bar"]
@@ -198,7 +198,7 @@ def test_bar_rings_turn_past_180_degrees_as_their_labels_say(collections):
     X0 = col.extras["rest"].reshape(n_along, n_around, 3)
     for motion in ("twist", "bend", "twist_bend"):
         idx = np.nonzero(col.labels["motion"] == motion)[0]
-        last = idx[np.argmax(col.labels["turn_deg"][idx])]
+        last = idx[np.argmax(col.extras["turn_deg"][idx])]
         rings = _ring_rotations(col, last)
         X = col.vertices[last].reshape(n_along, n_around, 3)
         # each ring is a rigid copy of its rest ring (to round-off)
@@ -210,7 +210,7 @@ def test_bar_rings_turn_past_180_degrees_as_their_labels_say(collections):
         assert step_angles.max() < np.deg2rad(20)
         accumulated = np.rad2deg(step_angles.sum())
         assert accumulated > 180.0, f"{motion}: rings turned only {accumulated:.0f} deg"
-        assert abs(accumulated - col.labels["turn_deg"][last]) < 0.01 * accumulated + 1
+        assert abs(accumulated - col.extras["turn_deg"][last]) < 0.01 * accumulated + 1
         centre = X.mean(axis=1)
         straight = np.linalg.norm(np.cross(centre - centre[0], centre[-1] - centre[0]), axis=1).max()
         if motion == "twist":
