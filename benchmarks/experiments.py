@@ -8,7 +8,9 @@ were recorded (``results.json`` holds the definitions' fingerprint, the commit, 
 the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
-  ``meshvae_lib.paper``), plus renderings: ``generation_meshes.png`` (generated meshes over
+  ``meshvae_lib.paper``; ``table2_converged`` is Table 2 with every model trained until its
+  validation error stops improving, its curves in ``table2_features_converged_curves.png`` and in
+  ``results.json``), plus renderings: ``generation_meshes.png`` (generated meshes over
   their nearest training meshes), ``interpolation_meshes.png`` (Fig. 4), ``exploration_level1.png``
   and ``exploration_level2.png`` (Fig. 8);
 - ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
@@ -39,6 +41,8 @@ from meshvae_lib import paper  # noqa: E402
 SHORT = {
     "table1": paper.latent_size_table,
     "table2": paper.feature_table,
+    "table2_converged": lambda settings, cache: paper.feature_table(
+        settings=dataclasses.replace(settings, converge=True), cache=cache),
     "table3": paper.robustness_table,
     "loss": paper.loss_table,
     "embedding": paper.embedding_table,
@@ -87,6 +91,11 @@ def _renderings(table, out: Path) -> list[str]:
                                suptitle="rows: " + " / ".join(names) + "   (x: crossing triangle pairs)"),
               out / "interpolation_meshes.png")
         written.append("interpolation_meshes.png")
+    if "curves" in d:  # a converged table: the validation curve of every model
+        from meshvae_lib.paper.plots import plot_validation_curves
+
+        _save(plot_validation_curves(table), out / f"{table.name}_curves.png")
+        written.append(f"{table.name}_curves.png")
     if table.name == "exploration":
         for key, fname in (("level1", "exploration_level1.png"), ("level2", "exploration_level2.png")):
             g = d[key]
@@ -107,8 +116,11 @@ def _jsonable(table) -> dict:
             return int(c)
         return None if c is None else str(c)
 
-    return {"name": table.name, "title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
-            "notes": table.notes, "seconds": table.seconds}
+    out = {"name": table.name, "title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
+           "notes": table.notes, "seconds": table.seconds}
+    if "curves" in table.data:  # a converged table keeps every model's validation curve
+        out["curves"] = table.data["curves"]
+    return out
 
 
 def _write_summary(out, args, settings, total, parts, results, failed, done: bool, provenance: dict) -> None:

@@ -330,3 +330,25 @@ def test_definition_fingerprint_and_read_results(tmp_path):
         paper.read_results(path)
     with pytest.raises(FileNotFoundError, match="make experiments"):
         paper.read_results(tmp_path / "nope.json")
+
+
+def test_converged_feature_table_trains_each_model_until_its_validation_error_stops_improving(coll):
+    """With ``converge`` every model's epochs come from early stopping (at most ``converge_epochs``),
+    its validation curve is kept, and a curve is 'flat' only when patience, not the limit, stopped it."""
+    import dataclasses
+
+    s = dataclasses.replace(SETTINGS, converge=True, converge_epochs=40, patience=10)
+    t = paper.feature_table([coll], settings=s, cache={})
+    assert t.name == "table2_features_converged" and "stops improving" in t.title
+    curves = t.data["curves"]["ellipsoids"]
+    assert set(curves) == {"coords", "aligned", "rimd"}
+    for kind, c in curves.items():
+        assert c["epochs"][0] == 0 and c["epochs"] == sorted(c["epochs"]) and c["epochs"][-1] <= 40
+        assert len(c["val_mse"]) == len(c["epochs"]) and np.all(np.isfinite(c["val_mse"]))
+        best = c["epochs"][int(np.argmin(c["val_mse"]))]
+        assert c["chosen"] == best, kind  # the model is retrained for the best epoch
+        assert c["flat"] == (c["epochs"][-1] - best >= 10 and c["epochs"][-1] < 40)
+    assert any("trained until its validation MSE" in n for n in t.notes)
+    from meshvae_lib.paper.plots import plot_validation_curves
+
+    assert len(plot_validation_curves(t).axes) == 1 and t.plot().axes

@@ -11,7 +11,7 @@ import textwrap
 
 import numpy as np
 
-__all__ = ["plot_table", "PLOTS"]
+__all__ = ["plot_table", "plot_validation_curves", "PLOTS"]
 
 #: the y label of the error plots: the tables' numbers, the mean vertex distance after alignment.
 ERROR_LABEL = "held-out per-vertex error (mesh units)"
@@ -173,10 +173,33 @@ def plot_embedding(table):
     return fig
 
 
+def plot_validation_curves(table):
+    """A converged table's validation curves (``data["curves"]``: collection -> kind -> ``epochs``,
+    ``val_mse``, ``chosen``): one panel per collection, one line per input kind, the chosen epoch
+    marked; a curve that ends flat stopped by patience, not by the epoch limit."""
+    curves = table.data["curves"]
+    fig = _figure(2.6 * len(curves), 2.8)
+    for i, (name, kinds) in enumerate(curves.items()):
+        ax = fig.add_subplot(1, len(curves), i + 1)
+        for kind, c in kinds.items():
+            line, = ax.semilogy(c["epochs"], c["val_mse"], label=kind, lw=1)
+            best = int(np.argmin(c["val_mse"]))
+            ax.plot(c["epochs"][best], c["val_mse"][best], "o", color=line.get_color(), ms=3)
+        ax.set_title(name, fontsize=8)
+        ax.set_xlabel("epoch", fontsize=7)
+        ax.tick_params(labelsize=6)
+        if i == 0:
+            ax.set_ylabel("validation MSE (Eq. 3 units)", fontsize=7)
+            ax.legend(fontsize=6)
+    fig.suptitle(table.title + ": validation curves (dot: the chosen epoch)", fontsize=8)
+    return fig
+
+
 #: experiment (table name) -> its plot.
 PLOTS = {
     "table1_latent_size": plot_latent_size,
     "table2_features": plot_features,
+    "table2_features_converged": plot_features,
     "table3_robustness": plot_robustness,
     "loss_mse_vs_bce": plot_loss,
     "embedding_auc": plot_embedding,

@@ -47,6 +47,11 @@ class ExperimentSettings:
     seed : seeds data, initial weights, shuffling and sampling
     embedding_steps : Adam steps of the embedding models (Sec. 5.4), which need longer training
         than the error tables for the latent cost to shape the map
+    converge : False (default): every model trains ``train_steps``; True: every model trains until
+        its validation error stops improving (the library's early stopping on every 8th training
+        mesh, ``patience`` epochs without a lower validation MSE, at most ``converge_epochs``), the
+        validation curve kept with the model (``benchmarks/experiments.py`` runs Table 2 this way)
+    converge_epochs, patience : bounds of ``converge``
     """
 
     resolution: int | None = 400
@@ -60,6 +65,9 @@ class ExperimentSettings:
     layout: str = "compact"
     seed: int = 0
     embedding_steps: int = 1000
+    converge: bool = False
+    converge_epochs: int = 3000
+    patience: int = 200
 
     @classmethod
     def quick(cls, **kw) -> "ExperimentSettings":
