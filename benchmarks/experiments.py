@@ -91,7 +91,7 @@ def _renderings(table, out: Path) -> list[str]:
                                suptitle="rows: " + " / ".join(names) + "   (x: crossing triangle pairs)"),
               out / "interpolation_meshes.png")
         written.append("interpolation_meshes.png")
-    if "curves" in d:  # a converged table: the validation curve of every model
+    if "validation_curves" in d:  # a converged table: the validation curve of every model
         from meshvae_lib.paper.plots import plot_validation_curves
 
         _save(plot_validation_curves(table), out / f"{table.name}_curves.png")
@@ -118,8 +118,8 @@ def _jsonable(table) -> dict:
 
     out = {"name": table.name, "title": table.title, "columns": table.columns, "rows": [[cell(c) for c in r] for r in table.rows],
            "notes": table.notes, "seconds": table.seconds}
-    if "curves" in table.data:  # a converged table keeps every model's validation curve
-        out["curves"] = table.data["curves"]
+    if "validation_curves" in table.data:  # a converged table keeps every model's validation curve
+        out["validation_curves"] = table.data["validation_curves"]
     return out
 
 

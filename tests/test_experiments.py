@@ -340,7 +340,7 @@ def test_converged_feature_table_trains_each_model_until_its_validation_error_st
     s = dataclasses.replace(SETTINGS, converge=True, converge_epochs=40, patience=10)
     t = paper.feature_table([coll], settings=s, cache={})
     assert t.name == "table2_features_converged" and "stops improving" in t.title
-    curves = t.data["curves"]["ellipsoids"]
+    curves = t.data["validation_curves"]["ellipsoids"]
     assert set(curves) == {"coords", "aligned", "rimd"}
     for kind, c in curves.items():
         assert c["epochs"][0] == 0 and c["epochs"] == sorted(c["epochs"]) and c["epochs"][-1] <= 40

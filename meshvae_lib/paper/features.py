@@ -64,7 +64,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
                 for k, m in models.items()}
         table.data["errors"][name] = errs
         if s.converge:
-            table.data.setdefault("curves", {})[name] = {k: _curve(m, s) for k, m in models.items()}
+            table.data.setdefault("validation_curves", {})[name] = {k: _curve(m, s) for k, m in models.items()}
         floor = table.data["linear_floor"][name] = linear_floor(coll.vertices, s.holdout_every)
         gn_cell = []
         if gn:
@@ -91,10 +91,10 @@ def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
                        " on it is a training residual, and the row says nothing about a representation"
                        " (not informative: left out of any summary of the ordering).")
     if s.converge:
-        open_ended = [f"{c} {k}" for c, kinds_ in table.data["curves"].items() for k, cv in kinds_.items() if not cv["flat"]]
+        open_ended = [f"{c} {k}" for c, kinds_ in table.data["validation_curves"].items() for k, cv in kinds_.items() if not cv["flat"]]
         table.notes.append(f"Every model trained until its validation MSE (every 8th training mesh) did not improve for"
                            f" {s.patience} epochs (at most {s.converge_epochs}), then retrained on all training meshes"
-                           " for the best number of epochs; the curves are in data['curves'] ("
+                           " for the best number of epochs; the curves are in data['validation_curves'] ("
                            + ("all flat at the end)" if not open_ended else
                               "still falling at the last epoch: " + ", ".join(open_ended) + ")") + ".")
     if gn:

@@ -174,10 +174,10 @@ def plot_embedding(table):
 
 
 def plot_validation_curves(table):
-    """A converged table's validation curves (``data["curves"]``: collection -> kind -> ``epochs``,
+    """A converged table's validation curves (``data["validation_curves"]``: collection -> kind -> ``epochs``,
     ``val_mse``, ``chosen``): one panel per collection, one line per input kind, the chosen epoch
     marked; a curve that ends flat stopped by patience, not by the epoch limit."""
-    curves = table.data["curves"]
+    curves = table.data["validation_curves"]
     fig = _figure(2.6 * len(curves), 2.8)
     for i, (name, kinds) in enumerate(curves.items()):
         ax = fig.add_subplot(1, len(curves), i + 1)
