@@ -91,7 +91,7 @@ def _rest_tube(resolution: int):
 
 
 def make_bar(seed: int = 0, resolution: int | None = None,
-             n_variants: int = C.BAR_N_FRAMES_PER_MOTION) -> SynthCollection:
+             n_variants: int = C.BAR_VARIANTS) -> SynthCollection:
     """Bar collection: 3 motions x ``n_variants`` independent draws; labels ``motion``, ``variant``,
     ``twist_deg`` (the end rings' twist about the bar) and ``bend_deg`` (the bending accumulated
     along it); ``extras["turn_deg"]`` (n,) int64: all rotation accumulated from ring to ring."""
@@ -99,6 +99,7 @@ def make_bar(seed: int = 0, resolution: int | None = None,
     V0, F, tube_shape = _rest_tube(resolution)
     rng = np.random.default_rng(seed)
     scale = np.deg2rad(np.asarray(C.BAR_PROFILE_DEG, float))  # (2, 3): twist modes, bend modes
+    s_rings = np.unique(V0[:, 0])
     chunks, names, motion, variant, tw, bd, turns = [], [], [], [], [], [], []
     for m, (w_twist, w_bend) in BAR_MOTIONS.items():
         n = n_variants
@@ -107,7 +108,6 @@ def make_bar(seed: int = 0, resolution: int | None = None,
         bend_y, bend_z = (draw() * scale[1] * w_bend for _ in range(2))
         V, turn = rod_deform(V0, twist, bend_y, bend_z)
         chunks.append(V)
-        s_rings = np.unique(V0[:, 0])
         bend_rate = np.hypot(_profiles(s_rings, bend_y), _profiles(s_rings, bend_z))
         for i in range(n):
             names.append(f"{m}_{i:02d}")

@@ -120,7 +120,8 @@ BAR_LENGTH = 4.0
 BAR_RADIUS = 0.35
 #: exponent of the bar's superellipse cross section (2: circle; larger: squarer).
 BAR_SQUARENESS = 4.0
-BAR_N_FRAMES_PER_MOTION = 20
+#: meshes per motion of the bar, each an independent draw of its profiles
+BAR_VARIANTS = 20
 #: spread (standard deviation, degrees) of the bar's profile modes: rows twist, bend (in each of the
 #: two planes); columns the constant, linear and quadratic mode along the bar
 BAR_PROFILE_DEG = ((150.0, 120.0, 60.0), (100.0, 80.0, 40.0))

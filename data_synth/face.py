@@ -20,11 +20,11 @@ from scipy.spatial.transform import Rotation
 from data_synth import constants as C
 from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
-from data_synth.skeleton import axis_rotation
 
 __all__ = ["make_face", "face_template", "blendshapes", "EXPRESSIONS"]
 
-#: expression -> blendshape weights at its peak
+#: expression -> blendshape weights at its peak ("jaw_open": the jaw's rotation, as a fraction of
+#: ``FACE_JAW_ANGLE``, not a blendshape)
 EXPRESSIONS = {
     "smile": {"smile": 1.0, "cheek_raise": 0.8},
     "laugh": {"smile": 1.0, "cheek_raise": 1.0, "jaw_open": 0.6},
@@ -93,9 +93,9 @@ def _jaw_weights(V: np.ndarray):
 
 
 def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
-    """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1."""
+    """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1 (the jaw is not
+    one: it turns about its hinge, :func:`_jaw_rotation`)."""
     x = V[:, 0]
-    front = _smoothstep((V[:, 2] - 0.03) / 0.04)
     sx = np.tanh(x / 0.012)  # a smooth 'which side' (a sign would tear the midline)
     out = {}
     corner = sum(_gauss(V, (s * 0.026, -0.044, 0.092), (0.014, 0.012, 0.02)) for s in (1, -1))
@@ -119,13 +119,10 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     normals_out = V - np.array([0.0, -0.03, 0.0])
     normals_out /= np.linalg.norm(normals_out, axis=1, keepdims=True)
     out["cheek_puff"] = 0.01 * puff[:, None] * normals_out
-    pivot, w = _jaw_weights(V)
     out = {k: C.FACE_BLENDSHAPE_SCALE * d for k, d in out.items()}
     # pucker: the lips push forward (scaled like the others) and draw together sideways (not
     # scaled: more would crush the edges across the mouth)
     out["pucker"] = np.stack([-0.3 * x, np.zeros_like(x), C.FACE_BLENDSHAPE_SCALE * 0.009 * np.ones_like(x)], 1) * lips[:, None]
-    R = axis_rotation((1.0, 0.0, 0.0), C.FACE_JAW_ANGLE)
-    out["jaw_open"] = ((V - pivot) @ R.T + pivot - V) * w[:, None]
     return out
 
 
