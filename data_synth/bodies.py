@@ -7,10 +7,10 @@ import numpy as np
 from data_synth import constants as C
 from data_synth.collection import SynthCollection
 from data_synth.humanoid import NAMES, BodyShape, body_template, pose_body, shape_body
-from data_synth.motions import MOTIONS, Pose, motion_sequence, random_poses
+from data_synth.motions import MOTIONS, Pose, limb_clearance, motion_sequence, random_poses
 from data_synth.skeleton import forward_kinematics
 
-__all__ = ["make_scape", "make_dyna", "make_jumping", "DYNA_SHAPES", "pose_shape"]
+__all__ = ["make_scape", "make_dyna", "make_jumping", "DYNA_SHAPES", "pose_shape", "checked_sequence"]
 
 #: the Dyna-like collection's body shapes (jittered a little per seed).
 DYNA_SHAPES = {
@@ -39,6 +39,17 @@ def pose_shape(template, shape: BodyShape, pose: Pose) -> np.ndarray:
     return pose_body(V_rest, joints, template, pose.local, root)
 
 
+def checked_sequence(name: str, n_frames: int, rng: np.random.Generator, **options) -> Pose:
+    """:func:`~data_synth.motions.motion_sequence` drawn again (at most :data:`constants.POSE_DRAWS`
+    times) until every frame passes the skeleton check (:func:`~data_synth.motions.limb_clearance`:
+    no arm through the other arm or the head)."""
+    for _ in range(C.POSE_DRAWS):
+        pose = motion_sequence(name, n_frames, rng, **options)
+        if (limb_clearance(pose) >= 0.0).all():
+            return pose
+    raise RuntimeError(f"no draw of motion {name!r} in {C.POSE_DRAWS} passed the skeleton check")
+
+
 def _jitter(shape: BodyShape, rng: np.random.Generator) -> BodyShape:
     j = lambda v: float(v * rng.uniform(0.98, 1.02))  # noqa: E731
     return BodyShape(height=j(shape.height), girth=j(shape.girth), arm_length=j(shape.arm_length),
@@ -48,7 +59,9 @@ def _jitter(shape: BodyShape, rng: np.random.Generator) -> BodyShape:
 
 def make_scape(seed: int = 0, resolution: int | None = None,
                n_poses: int = C.SCAPE_N_POSES) -> SynthCollection:
-    """One body in ``n_poses`` distinct poses (the paper's SCAPE has 71), rest pose first."""
+    """One body in ``n_poses`` distinct poses (the paper's SCAPE has 71), rest pose first: random
+    frames of random motions with every joint moved independently, each passing the skeleton check
+    (:func:`~data_synth.motions.random_poses`)."""
     rng = np.random.default_rng(seed)
     template = body_template(resolution)
     shape = _jitter(BodyShape(), rng)
@@ -70,6 +83,10 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
               frames_per_motion: int = C.DYNA_FRAMES_PER_MOTION) -> SynthCollection:
     """Several body shapes x several motions (Dyna-like), labelled ``shape``, ``motion``, ``frame``.
 
+    Each (shape, motion) is its own performance: the frames start at a random point of the motion's
+    first frame interval and carry a performer's variation (:meth:`~data_synth.motions.Pose.vary`),
+    so no two meshes repeat (the rest pose is never a frame).
+
     ``extras['shape_params']`` maps each shape name to its parameters; ``extras['shape_matrix']``
     is ``(n_shapes, 5) float64`` (height, girth, arm_length, leg_length, shoulder_width) in the
     order of ``extras['shape_names']``, ``extras['body_type']`` gives male/female per shape and
@@ -89,7 +106,7 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
         params[s] = shape.as_dict()
         shape_rest.append(shape_body(template, shape)[0])
         for m in motions:
-            pose = motion_sequence(m, frames_per_motion, rng)
+            pose = checked_sequence(m, frames_per_motion, rng, offset=rng.uniform(), vary=C.DYNA_VARY)
             chunks.append(pose_shape(template, shape, pose))
             for f in range(frames_per_motion):
                 names.append(f"{s}_{m}_{f:02d}")
@@ -112,15 +129,18 @@ def make_dyna(seed: int = 0, resolution: int | None = None, shapes=None, motions
 
 def make_jumping(seed: int = 0, resolution: int | None = None,
                  n_frames: int = C.JUMPING_N_FRAMES) -> SynthCollection:
-    """One body doing jumping jacks, a smooth sequence (like Vlasic et al.'s 'Jumping')."""
+    """One body doing :data:`constants.JUMPING_REPS` jumping jacks in ``n_frames`` frames (like
+    Vlasic et al.'s 'Jumping'), each jack its own height and width, with a performer's variation
+    (:meth:`~data_synth.motions.Pose.vary`)."""
     rng = np.random.default_rng(seed)
     template = body_template(resolution)
     shape = _jitter(BodyShape(height=1.70, girth=0.95), rng)
-    pose = motion_sequence("jumping_jacks", n_frames, rng)
+    pose = checked_sequence("jumping_jacks", n_frames, rng, vary=C.JUMPING_VARY, cycles=C.JUMPING_CYCLES,
+                           reps=C.JUMPING_REPS)
     V = pose_shape(template, shape, pose)
     return SynthCollection(
         vertices=V, faces=template.F.copy(), names=[f"frame_{i:03d}" for i in range(n_frames)],
         labels={"frame": np.arange(n_frames, dtype=np.int64)},
-        description="Jumping-like: one body doing jumping jacks, a smooth sequence",
+        description="Jumping-like: one body doing jumping jacks, 10 frames a jack",
         extras={"rest": shape_body(template, shape)[0], "shape_params": shape.as_dict()},
     )

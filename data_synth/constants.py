@@ -71,6 +71,43 @@ SCAPE_N_POSES = 71
 JUMPING_N_FRAMES = 120
 #: default frames per motion in the Dyna-like collection.
 DYNA_FRAMES_PER_MOTION = 6
+#: jumping jacks in the Jumping-like sequence: 10 frames each at the default length, like a capture
+#: at about 8 frames per second (at 30 any smooth sequence is linear data: every frame is a
+#: combination of its neighbours; measured, 5 jacks in 120 frames: PCA floor 2e-6 of the diagonal).
+JUMPING_REPS = 12
+#: the arms' "lower" angle (radians from the A-pose) when they hang down, with room for a
+#: performer's variation before an upper arm passes into the torso (measured in the rest pose: 0.55
+#: is clear for all five Dyna shapes, 0.62 is not for the heavy ones).
+ARM_DOWN = 0.4
+#: how far jumping jacks raise the arms from ARM_DOWN (radians; 2.5 with the shrug pushes the upper
+#: arms into a slim head).
+JACKS_ARM_RAISE = 1.95
+#: a performer never repeats a motion exactly: smooth random rotations (radians, RMS, about each of
+#: the three axes) added to every joint of a motion by ``Pose.vary``, and the highest frequency of
+#: those signals in cycles per pass of the motion.
+PERFORMANCE_RANGE = {
+    "spine": 0.05, "chest": 0.05, "neck": 0.08, "head": 0.15,
+    "clavicle": 0.05, "upperarm": 0.12, "forearm": 0.12, "hand": 0.3,
+    "thigh": 0.05, "shin": 0.06, "foot": 0.12,
+}
+PERFORMANCE_CYCLES = 6
+#: the skeleton check of poses (``motions.limb_clearance``): the least distance (metres) between
+#: the two arms, and between an arm or a hand and the centre of the head, that a pose may keep
+#: (the head is 0.16 m wide, an upper arm 0.1 m thick, a hand 0.09 m wide).
+ARM_ARM_CLEARANCE = 0.12
+ARM_HEAD_CLEARANCE = 0.13
+HAND_HEAD_CLEARANCE = 0.16
+#: where the head's centre lies from the head joint in the rest pose (metres).
+HEAD_CENTRE_OFFSET = (0.0, 0.095, 0.015)
+#: the SCAPE-like poses' independent per-joint variation, in units of PERFORMANCE_RANGE.
+SCAPE_VARY = 1.0
+#: the Dyna-like and Jumping-like performers' variation (units of PERFORMANCE_RANGE) and, for the
+#: jumping sequence, its highest frequency in cycles per pass.
+DYNA_VARY = 1.0
+JUMPING_VARY = 1.2
+JUMPING_CYCLES = 40
+#: how many times a body collection redraws a motion whose frames fail the skeleton check.
+POSE_DRAWS = 50
 
 # --- hand and face ----------------------------------------------------------------------------
 HAND_DEFAULT_RESOLUTION = 1800

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from data_synth import constants as C
-from data_synth.humanoid import NAMES
-from data_synth.skeleton import axis_rotation
+from data_synth.humanoid import NAMES, _base_points, body_skeleton
+from data_synth.skeleton import axis_rotation, forward_kinematics
 
-__all__ = ["Pose", "MOTIONS", "motion_sequence", "random_poses"]
+__all__ = ["Pose", "MOTIONS", "motion_sequence", "random_poses", "smooth_signals", "limb_clearance"]
 
 _X, _Y, _Z = np.eye(3)
 
@@ -82,10 +82,36 @@ class Pose:
         self.rotate("head", _Y, np.asarray(head_turn))
         return self
 
+    def vary(self, signals: np.ndarray, scale: float = 1.0) -> "Pose":
+        """Add a performer's variation: every joint of :data:`constants.PERFORMANCE_RANGE` turns
+        about x, y and z by its range x ``scale`` x a column of ``signals (n_frames, 3 n_joints)``
+        (three columns per joint in ``NAMES`` order; :func:`smooth_signals`)."""
+        for j, name in enumerate(NAMES):
+            part = name[2:] if name[1] == "_" else name
+            amount = scale * C.PERFORMANCE_RANGE.get(part, 0.0)
+            if amount:
+                for a, axis in enumerate((_X, _Y, _Z)):
+                    angle = amount * signals[:, 3 * j + a]
+                    if part in ("upperarm", "clavicle", "thigh") and a == 2:  # only away from the body
+                        angle = (1.0 if name[0] == "l" else -1.0) * np.abs(angle)
+                    self.rotate(name, axis, angle)
+        return self
+
     def root_turn(self, yaw=0.0, pitch=0.0) -> "Pose":
         self.rotate("pelvis", _X, pitch)
         self.rotate("pelvis", _Y, yaw)
         return self
+
+
+def smooth_signals(phase, rng: np.random.Generator, n_channels: int, cycles: int) -> np.ndarray:
+    """Smooth random signals ``(n_frames, n_channels) float64`` over one pass of ``phase (n_frames,)``:
+    random Fourier series with 1 .. ``cycles`` cycles per pass, amplitudes falling as 1/k and random
+    phases, scaled to unit RMS over a whole pass (exactly: by the coefficients, not by the frames)."""
+    k = np.arange(1, cycles + 1, dtype=np.float64)
+    amp = rng.normal(size=(n_channels, cycles)) / k
+    shift = rng.uniform(0.0, 2.0 * np.pi, size=(n_channels, cycles))
+    waves = np.sin(2.0 * np.pi * k * np.asarray(phase, np.float64)[:, None, None] + shift)
+    return (amp * waves).sum(axis=2) / np.sqrt(0.5 * (amp**2).sum(axis=1))
 
 
 def _smooth_pulse(x):
@@ -109,7 +135,7 @@ def walk(phase, rng, run=False):
         swing = (0.5 + 0.5 * c) ** 2  # knee bends while the thigh swings forward
         p.leg(side, hip=amp * hip_a * s + (0.25 if run else 0.0), knee=0.08 + amp * knee_a * swing,
               ankle=0.15 * np.maximum(-s, 0) - 0.1 * swing)
-        p.arm(side, lower=0.62, forward=-amp * arm_a * s, elbow=elbow + 0.2 * (0.5 + 0.5 * s))
+        p.arm(side, lower=C.ARM_DOWN, forward=-amp * arm_a * s, elbow=elbow + 0.2 * (0.5 + 0.5 * s))
     p.trunk(bend=lean, twist=0.12 * np.sin(phi), head_nod=-lean)
     p.root_turn(yaw=-0.08 * np.sin(phi), pitch=0.5 * lean)
     speed = 1.4 if not run else 2.6
@@ -122,18 +148,23 @@ def run(phase, rng):
     return walk(phase, rng, run=True)
 
 
-def jumping_jacks(phase, rng):
+def jumping_jacks(phase, rng, reps=2.0):
+    """``reps`` jumping jacks per pass; each repetition reaches its own height and width (a
+    performer never repeats exactly)."""
     n = len(phase)
-    reps = 2.0
     phi = 2.0 * np.pi * reps * phase + rng.uniform(-0.2, 0.2)
-    s = 0.5 - 0.5 * np.cos(phi)  # 0: arms down, legs together; 1: arms up, legs apart
-    up = rng.uniform(0.95, 1.05)
+    s = _smooth_pulse(0.5 - 0.5 * np.cos(phi))  # 0: arms down, legs together; 1: arms up, legs apart
+    cycles = max(2, int(np.ceil(reps)))
+    vary = smooth_signals(phase, rng, 3, cycles)
+    up = rng.uniform(0.95, 1.05) + 0.04 * np.clip(vary[:, 0], -1.0, 1.0)
+    wide = 1.0 + 0.15 * vary[:, 1]
     p = Pose.identity(n)
-    for side in ("l", "r"):
-        p.arm(side, lower=0.7 - up * 2.75 * s, shrug=0.55 * s, elbow=0.15 + 0.1 * s,
-              forward=0.1 * (1 - s))
-        p.leg(side, spread=0.06 + 0.24 * s, knee=0.3 * (1 - np.abs(np.sin(phi))), hip=0.15 * (1 - np.abs(np.sin(phi))),
-              ankle=0.35 * np.abs(np.sin(phi)))
+    for k, side in enumerate(("l", "r")):
+        lag = 0.05 * vary[:, 2] * (1 if k else -1)  # one arm a little ahead of the other
+        p.arm(side, lower=C.ARM_DOWN - up * C.JACKS_ARM_RAISE * np.clip(s + lag, 0, 1), shrug=0.5 * s,
+              elbow=0.15 + 0.1 * s, forward=0.1 * (1 - s))
+        p.leg(side, spread=0.06 + 0.24 * wide * s, knee=0.3 * (1 - np.abs(np.sin(phi))),
+              hip=0.15 * (1 - np.abs(np.sin(phi))), ankle=0.35 * np.abs(np.sin(phi)))
     p.trunk(head_nod=-0.1 * s)
     p.root[:, 1] = 0.12 * np.abs(np.sin(phi)) - 0.05 * (1 - np.abs(np.sin(phi)))
     return p
@@ -150,7 +181,7 @@ def punch(phase, rng):
     ext *= rng.uniform(0.9, 1.0)
     for side, idx in (("l", 0), ("r", 1)):
         e = np.where(which == idx, ext, 0.0)
-        p.arm(side, lower=0.5 - 0.05 * e, forward=0.9 + 0.6 * e, twist=0.0, shrug=0.15,
+        p.arm(side, lower=C.ARM_DOWN - 0.05 * e, forward=0.9 + 0.6 * e, twist=0.0, shrug=0.15,
               elbow=1.9 * (1 - e) + 0.1)
     twist = 0.35 * np.where(which == 0, -ext, ext)
     p.trunk(twist=twist, bend=0.1)
@@ -170,7 +201,7 @@ def squat(phase, rng):
     for side in ("l", "r"):
         # thigh 60 degrees forward, shin 30 degrees back, foot flat: hip, knee, ankle follow
         p.leg(side, hip=1.05 * s + pitch, knee=1.55 * s, ankle=-0.5 * s, spread=0.12 * s)
-        p.arm(side, lower=0.7 - 0.25 * s, forward=1.35 * s, elbow=0.2 * s, shrug=0.15 * s)
+        p.arm(side, lower=C.ARM_DOWN - 0.05 * s, forward=1.35 * s, elbow=0.2 * s, shrug=0.15 * s)
     p.trunk(bend=0.2 * s, head_nod=-0.5 * s)
     p.root_turn(pitch=pitch)
     p.plant = ("l_foot", "r_foot")
@@ -183,9 +214,9 @@ def wave(phase, rng):
     raise_ = _smooth_pulse(phase / 0.25) * (1 - _smooth_pulse((phase - 0.8) / 0.2))
     freq = rng.uniform(2.5, 3.5)
     osc = np.sin(2 * np.pi * freq * phase) * raise_
-    p.arm("r", lower=0.7 - 1.55 * raise_, twist=-1.4 * raise_, elbow=(1.2 + 0.45 * osc) * raise_
+    p.arm("r", lower=C.ARM_DOWN - 1.35 * raise_, twist=-1.4 * raise_, elbow=(1.2 + 0.45 * osc) * raise_
           + 0.15, shrug=0.15 * raise_)
-    p.arm("l", lower=0.7, forward=0.05, elbow=0.15)
+    p.arm("l", lower=C.ARM_DOWN, forward=0.05, elbow=0.15)
     p.trunk(side=-0.08 * raise_, head_turn=-0.2 * raise_)
     return p
 
@@ -199,7 +230,7 @@ def turn(phase, rng):
     for side, sgn in (("l", 1.0), ("r", -1.0)):
         lift = np.maximum(sgn * step, 0.0)
         p.leg(side, hip=0.45 * lift, knee=0.8 * lift, ankle=-0.2 * lift)
-        p.arm(side, lower=0.62, forward=0.1 * sgn * step, elbow=0.35)
+        p.arm(side, lower=C.ARM_DOWN, forward=0.1 * sgn * step, elbow=0.35)
     p.trunk(twist=-0.15 * direction, head_turn=0.3 * direction)
     p.root_turn(yaw=yaw)
     return p
@@ -217,21 +248,51 @@ MOTIONS = {
 }
 
 
-def motion_sequence(name: str, n_frames: int, rng: np.random.Generator) -> Pose:
-    """Frames ``0 .. n_frames - 1`` of motion ``name``, evenly spaced over one pass."""
+def motion_sequence(name: str, n_frames: int, rng: np.random.Generator, offset: float = 0.0,
+                    vary: float = 0.0, cycles: int = C.PERFORMANCE_CYCLES, **options) -> Pose:
+    """Frames ``0 .. n_frames - 1`` of motion ``name``, evenly spaced over one pass and started
+    ``offset`` (in [0, 1): a fraction of the spacing) after its beginning; ``vary`` scales the
+    performer's variation (:meth:`Pose.vary`, 0: none), whose signals have up to ``cycles`` cycles
+    per pass; ``options`` go to the motion."""
     if name not in MOTIONS:
         raise ValueError(f"unknown motion {name!r}; motions are {sorted(MOTIONS)}")
     if n_frames < 1:
         raise ValueError(f"n_frames must be at least 1, got {n_frames}")
-    phase = np.arange(n_frames) / n_frames
-    return MOTIONS[name][0](phase, rng)
+    if not 0.0 <= offset < 1.0:
+        raise ValueError(f"offset must lie in [0, 1), got {offset}")
+    phase = (np.arange(n_frames) + offset) / n_frames
+    pose = MOTIONS[name][0](phase, rng, **options)
+    if vary:
+        pose.vary(smooth_signals(phase, rng, 3 * len(NAMES), cycles), vary)
+    return pose
 
 
-def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
-    """``n`` distinct poses: a random frame of a random motion plus random joint offsets.
+def limb_clearance(pose: Pose) -> np.ndarray:
+    """The skeleton check of a batch of poses, on the average body's skeleton: the least margin
+    (metres) by which the pose keeps the two arms (points along shoulder, elbow, wrist and
+    fingertips) :data:`constants.ARM_ARM_CLEARANCE` apart, and either arm from the middle of its
+    upper arm on :data:`constants.ARM_HEAD_CLEARANCE` (hands: ``HAND_HEAD_CLEARANCE``) from the
+    centre of the head. ``(n,) float64``; a pose passes when it is >= 0."""
+    skeleton = body_skeleton()
+    rest = _base_points()
+    R, p = forward_kinematics(skeleton, pose.local, pose.root)
+    t = np.linspace(0.0, 1.0, 5)[:-1]
+    arms = []
+    for s in "lr":
+        up, fore, hand = (NAMES.index(f"{s}_{b}") for b in ("upperarm", "forearm", "hand"))
+        tip = p[:, hand] + np.einsum("nab,b->na", R[:, hand], rest[f"{s}_hand_end"] - rest[f"{s}_hand"])
+        chain = [p[:, up], p[:, fore], p[:, hand], tip]
+        pts = [a[:, None] + t[None, :, None] * (b - a)[:, None] for a, b in zip(chain[:-1], chain[1:])]
+        arms.append(np.concatenate(pts + [tip[:, None]], axis=1))  # (n, 13, 3): 8 .. 12 the hand
+    arm_arm = np.linalg.norm(arms[0][:, :, None] - arms[1][:, None], axis=3).min(axis=(1, 2))
+    head = NAMES.index("head")
+    centre = p[:, head] + np.einsum("nab,b->na", R[:, head], C.HEAD_CENTRE_OFFSET)
+    need = np.where(np.arange(2, 13) >= 8, C.HAND_HEAD_CLEARANCE, C.ARM_HEAD_CLEARANCE)
+    margin = [np.linalg.norm(a[:, 2:] - centre[:, None], axis=2) - need for a in arms]
+    return np.minimum(arm_arm - C.ARM_ARM_CLEARANCE, np.min(np.concatenate(margin, axis=1), axis=1))
 
-    Returns the poses and, for each, the motion it started from.
-    """
+
+def _draw_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
     names = sorted(MOTIONS)
     chosen = [names[k] for k in rng.integers(0, len(names), size=n)]
     local = np.empty((n, len(NAMES), 3, 3))
@@ -251,4 +312,23 @@ def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
     # bending and nodding mostly forward (backwards pinches the back of the neck)
     pose.trunk(bend=rng.uniform(-0.1, 0.3, size=n), twist=u(0.4), side=u(0.2),
                head_nod=rng.uniform(-0.12, 0.3, size=n), head_turn=u(0.5))
+    # and every joint a little more, independently (wrists and ankles most)
+    pose.vary(rng.normal(size=(n, 3 * len(NAMES))), C.SCAPE_VARY)
     return pose, chosen
+
+
+def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
+    """``n`` distinct poses: a random frame of a random motion plus random joint offsets, drawn
+    until ``n`` pass the skeleton check (:func:`limb_clearance`: no arm through the other or
+    through the head).
+
+    Returns the poses and, for each, the motion it started from.
+    """
+    local, root, names = [], [], []
+    while sum(len(x) for x in local) < n:
+        pose, chosen = _draw_poses(n, rng)
+        keep = np.flatnonzero(limb_clearance(pose) >= 0.0)
+        local.append(pose.local[keep])
+        root.append(pose.root[keep])
+        names += [chosen[k] for k in keep]
+    return Pose(np.concatenate(local)[:n], np.concatenate(root)[:n], plant=("l_foot", "r_foot")), names[:n]

@@ -1,18 +1,27 @@
 """The registry of named synthetic collections: one interface for all generators.
 
-``make_collection(name, seed=0, resolution=None)`` builds a collection; ``resolution`` is the
-approximate vertex count of its template (None: the collection's default).
+``make_collection(name, seed=0, resolution=None, noise=0.0)`` builds a collection; ``resolution`` is
+the approximate vertex count of its template (None: the collection's default); ``noise`` adds
+capture noise (:mod:`data_synth.capture_noise`; off by default).
 """
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from typing import Callable
 
+import numpy as np
+
 from data_synth import bar, bodies, face, flag, hand
+from data_synth.capture_noise import add_capture_noise
 from data_synth.collection import SynthCollection
 
 __all__ = ["COLLECTIONS", "CollectionSpec", "list_collections", "make_collection", "SynthCollection"]
+
+
+#: the capture noise's random stream, apart from the generators' own (which use ``seed`` alone).
+NOISE_STREAM = 7
 
 
 @dataclass(frozen=True)
@@ -29,12 +38,12 @@ COLLECTIONS: dict[str, CollectionSpec] = {
     spec.name: spec
     for spec in (
         CollectionSpec("scape", bodies.make_scape,
-                       "one body in 71 distinct poses (2.5k vertices)", "SCAPE (Anguelov et al.)"),
+                       "one body in 71 distinct poses, every joint drawn (2.5k vertices)", "SCAPE (Anguelov et al.)"),
         CollectionSpec("dyna", bodies.make_dyna,
                        "5 body shapes x 7 motions x 6 frames, labels shape/motion/frame",
                        "Dyna (Pons-Moll et al.)"),
         CollectionSpec("jumping", bodies.make_jumping,
-                       "one body doing jumping jacks, 120 frames", "Vlasic et al.'s Jumping"),
+                       "one body doing 12 jumping jacks, 120 frames (about 8 a second)", "Vlasic et al.'s Jumping"),
         CollectionSpec("flag", flag.make_flag,
                        "a flag on a pole waving in gusty wind, 100 frames (one boundary loop)",
                        "the paper's flag"),
@@ -56,7 +65,8 @@ def list_collections() -> list[tuple[str, str]]:
     return [(spec.name, spec.description) for spec in COLLECTIONS.values()]
 
 
-def make_collection(name: str, seed: int = 0, resolution: int | None = None) -> SynthCollection:
+def make_collection(name: str, seed: int = 0, resolution: int | None = None,
+                    noise: float = 0.0) -> SynthCollection:
     """Build collection ``name``; deterministic for ``seed``.
 
     Parameters
@@ -64,6 +74,11 @@ def make_collection(name: str, seed: int = 0, resolution: int | None = None) -> 
     name : str, one of :data:`COLLECTIONS`.
     seed : int, non-negative.
     resolution : int or None, approximate vertex count of the template.
+    noise : float >= 0, capture noise: the standard deviation of independent Gaussian noise on every
+        vertex coordinate, as a fraction of each mesh's bounding-box diagonal (0: exact meshes). It
+        is drawn from its own generator (``[seed, NOISE_STREAM]``), so the meshes under it are the
+        same for every level; ``extras['noise']`` records the level and ``extras['exact']`` keeps
+        the exact meshes.
 
     Returns
     -------
@@ -80,4 +95,13 @@ def make_collection(name: str, seed: int = 0, resolution: int | None = None) -> 
         if isinstance(resolution, bool) or not hasattr(resolution, "__index__"):
             raise ValueError(f"resolution must be an integer vertex count, got {resolution!r}")
         resolution = int(resolution)
-    return COLLECTIONS[name].build(seed=int(seed), resolution=resolution)
+    if isinstance(noise, bool) or not isinstance(noise, numbers.Real) or not 0 <= noise < float("inf"):
+        raise ValueError(f"noise must be a finite number >= 0, got {noise!r}")
+    collection = COLLECTIONS[name].build(seed=int(seed), resolution=resolution)
+    if noise:
+        exact = collection.vertices
+        collection.vertices = add_capture_noise(exact, float(noise), np.random.default_rng([int(seed), NOISE_STREAM]))
+        collection.extras["exact"] = exact
+        collection.description += f", capture noise {noise:g} of the diagonal"
+    collection.extras["noise"] = float(noise)
+    return collection

@@ -64,3 +64,16 @@ def test_bad_input_is_one_line_error_with_exit_status_2(tmp_path, capsys):
     assert "missing" in capsys.readouterr().err
     assert main(["synth", "bar", "-o", str(tmp_path / "x.npz"), "--seed", "-1"]) == 2
     assert "--seed must be non-negative" in capsys.readouterr().err
+
+
+def test_noise_option_adds_capture_noise_and_rejects_negative_levels(tmp_path, capsys):
+    exact, noisy = tmp_path / "exact.npz", tmp_path / "noisy.npz"
+    assert main(["synth", "bar", "-o", str(exact)]) == 0
+    assert main(["synth", "bar", "-o", str(noisy), "--noise", "1e-3"]) == 0
+    a, b = np.load(exact)["vertices"], np.load(noisy)["vertices"]
+    diag = np.linalg.norm(a.max(axis=1) - a.min(axis=1), axis=1)
+    moved = np.linalg.norm(b - a, axis=2).mean(axis=1) / diag
+    np.testing.assert_allclose(moved, np.sqrt(8 / np.pi) * 1e-3, rtol=0.05)
+    capsys.readouterr()
+    assert main(["synth", "bar", "-o", str(noisy), "--noise", "-1"]) == 2
+    assert "--noise must be a finite number >= 0, got -1.0" in capsys.readouterr().err

@@ -139,17 +139,16 @@ def test_face_intensity_scales_the_expression(monkeypatch):
         assert np.abs(move[k]).max() > 1e-3, e
 
 
-def test_sequences_are_smooth():
-    """Consecutive frames of the jumping sequence move much less than the whole motion does (no
-    jumps between frames); the flag's frames are 1 / FLAG_FPS s apart in turbulent wind, far enough
-    for the folds to change, but consecutive frames are still nearer each other than frames far apart."""
-    col = make_collection("jumping", resolution=SMALL)
-    step = np.abs(np.diff(col.vertices, axis=0)).max()
-    span = np.abs(col.vertices - col.vertices[0]).max()
-    assert step < 0.2 * span, f"jumping: a frame jumps by {step:.3f} of {span:.3f}"
-    V = make_collection("flag", resolution=SMALL).vertices
-    gap = lambda lag: np.linalg.norm(V[lag:] - V[:-lag], axis=-1).mean()  # noqa: E731
-    assert gap(1) < 0.7 * gap(20), (gap(1), gap(20))
+def test_sequences_are_sampled_sparsely_but_continuously():
+    """The jumping sequence and the flag are captured at a few frames per second (about 8: at 30
+    any smooth sequence is linear data, issue 24): consecutive frames still move less than the whole
+    motion spans, and nearer frames are nearer each other than frames far apart."""
+    for name, far in (("jumping", 5), ("flag", 20)):  # jumping: half a jack apart (10 frames a jack)
+        V = make_collection(name, resolution=SMALL).vertices
+        gap = lambda lag: np.linalg.norm(V[lag:] - V[:-lag], axis=-1).mean()  # noqa: E731
+        span = np.linalg.norm(V - V.mean(axis=0), axis=-1).mean()
+        assert gap(1) < 0.7 * gap(far), (name, gap(1), gap(far))
+        assert gap(1) < 1.5 * span, (name, gap(1), span)
 
 
 def test_scape_poses_are_distinct():

@@ -26,6 +26,7 @@ examples:
   meshvae synth scape -o scape.npz
   meshvae synth dyna -o dyna/ --seed 3
   meshvae synth jumping -o jumping_7k.npz --resolution 7000
+  meshvae synth scape -o scape_noisy.npz --noise 1e-3
 """
 
 
@@ -38,6 +39,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--resolution", type=int, default=None, metavar="R",
                    help="approximate vertex count of the template (default: the collection's)")
+    p.add_argument("--noise", type=float, default=0.0, metavar="S",
+                   help="capture noise: Gaussian noise of S x the bounding-box diagonal on every vertex "
+                        "coordinate (default 0: exact meshes)")
     p.add_argument("--list", action="store_true", help="list the collections, one a line, and exit")
     return p
 
@@ -58,13 +62,15 @@ def run(args) -> int:
         raise UsageError("give the output with -o OUT (a .npz file or a folder)")
     if args.seed < 0:
         raise UsageError(f"--seed must be non-negative, got {args.seed}")
+    if not 0 <= args.noise < float("inf"):
+        raise UsageError(f"--noise must be a finite number >= 0, got {args.noise}")
     out = Path(args.output)
     if out.suffix.lower() == ".npz" and not out.parent.exists():
         raise UsageError(f"folder does not exist: {out.parent}")
     if out.exists() and not out.is_dir() and out.suffix.lower() != ".npz":
         raise UsageError(f"OUT must end in .npz or name a folder, got the file {out}")
     start = time.perf_counter()
-    col = make_collection(args.name, seed=args.seed, resolution=args.resolution)
+    col = make_collection(args.name, seed=args.seed, resolution=args.resolution, noise=args.noise)
     logger.info("built %s in %.2f s", args.name, time.perf_counter() - start)
     from meshvae_lib.geometry.collection_io import write_collection
 
