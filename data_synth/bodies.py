@@ -58,14 +58,17 @@ def _jitter(shape: BodyShape, rng: np.random.Generator) -> BodyShape:
 
 
 def make_scape(seed: int = 0, resolution: int | None = None,
-               n_poses: int = C.SCAPE_N_POSES) -> SynthCollection:
+               n_poses: int = C.SCAPE_N_POSES, diversity: float = 1.0) -> SynthCollection:
     """One body in ``n_poses`` distinct poses (the paper's SCAPE has 71), rest pose first: random
     frames of random motions with every joint moved independently, each passing the skeleton check
-    (:func:`~data_synth.motions.random_poses`)."""
+    (:func:`~data_synth.motions.random_poses`). ``diversity`` in [0, 2] scales the independent joint
+    draws (0: frames of the motions alone; notebook 09's lesson on when RIMD wins turns it)."""
+    if not 0.0 <= diversity <= 2.0:
+        raise ValueError(f"diversity must lie in [0, 2], got {diversity!r}")
     rng = np.random.default_rng(seed)
     template = body_template(resolution)
     shape = _jitter(BodyShape(), rng)
-    pose, sources = random_poses(n_poses - 1, rng)
+    pose, sources = random_poses(n_poses - 1, rng, diversity)
     rest = Pose.identity(1)
     pose = Pose(np.concatenate([rest.local, pose.local]), np.concatenate([rest.root, pose.root]),
                 plant=pose.plant)

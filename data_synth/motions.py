@@ -292,7 +292,7 @@ def limb_clearance(pose: Pose) -> np.ndarray:
     return np.minimum(arm_arm - C.ARM_ARM_CLEARANCE, np.min(np.concatenate(margin, axis=1), axis=1))
 
 
-def _draw_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
+def _draw_poses(n: int, rng: np.random.Generator, diversity: float) -> tuple[Pose, list]:
     names = sorted(MOTIONS)
     chosen = [names[k] for k in rng.integers(0, len(names), size=n)]
     local = np.empty((n, len(NAMES), 3, 3))
@@ -303,30 +303,31 @@ def _draw_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
         root[i, [0, 2]] = 0.0
     pose = Pose(local, root, plant=("l_foot", "r_foot"))
     # random offsets: spine and neck, and limbs within comfortable ranges
-    u = lambda a: rng.uniform(-a, a, size=n)  # noqa: E731
+    d = diversity
+    u = lambda a: rng.uniform(-d * a, d * a, size=n)  # noqa: E731
     for side in ("l", "r"):
         # arms mostly move away from the torso (pressing them into it would interpenetrate)
         pose.arm(side, lower=u(0.12) - np.abs(u(0.5)), forward=u(0.5), twist=u(0.4),
                  elbow=np.abs(u(0.6)))
         pose.leg(side, hip=u(0.25), knee=np.abs(u(0.3)), spread=np.abs(u(0.1)))
     # bending and nodding mostly forward (backwards pinches the back of the neck)
-    pose.trunk(bend=rng.uniform(-0.1, 0.3, size=n), twist=u(0.4), side=u(0.2),
-               head_nod=rng.uniform(-0.12, 0.3, size=n), head_turn=u(0.5))
+    pose.trunk(bend=d * rng.uniform(-0.1, 0.3, size=n), twist=u(0.4), side=u(0.2),
+               head_nod=d * rng.uniform(-0.12, 0.3, size=n), head_turn=u(0.5))
     # and every joint a little more, independently (wrists and ankles most)
-    pose.vary(rng.normal(size=(n, 3 * len(NAMES))), C.SCAPE_VARY)
+    pose.vary(rng.normal(size=(n, 3 * len(NAMES))), d * C.SCAPE_VARY)
     return pose, chosen
 
 
-def random_poses(n: int, rng: np.random.Generator) -> tuple[Pose, list]:
-    """``n`` distinct poses: a random frame of a random motion plus random joint offsets, drawn
-    until ``n`` pass the skeleton check (:func:`limb_clearance`: no arm through the other or
-    through the head).
+def random_poses(n: int, rng: np.random.Generator, diversity: float = 1.0) -> tuple[Pose, list]:
+    """``n`` distinct poses: a random frame of a random motion plus random joint offsets scaled by
+    ``diversity`` (0: the motions' frames alone; 1: the SCAPE-like default), drawn until ``n`` pass
+    the skeleton check (:func:`limb_clearance`: no arm through the other or through the head).
 
     Returns the poses and, for each, the motion it started from.
     """
     local, root, names = [], [], []
     while sum(len(x) for x in local) < n:
-        pose, chosen = _draw_poses(n, rng)
+        pose, chosen = _draw_poses(n, rng, diversity)
         keep = np.flatnonzero(limb_clearance(pose) >= 0.0)
         local.append(pose.local[keep])
         root.append(pose.root[keep])
