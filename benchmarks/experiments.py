@@ -8,9 +8,10 @@ were recorded (``results.json`` holds the definitions' fingerprint, the commit, 
 the machine and the run time). Writes, in ``--out``:
 
 - ``<experiment>.md`` and ``<experiment>.png`` for every experiment (see
-  ``meshvae_lib.paper``; ``table2_converged`` is Table 2 with every model trained until its
-  validation error stops improving, its curves in ``table2_features_converged_curves.png`` and in
-  ``results.json``), plus renderings: ``generation_meshes.png`` (generated meshes over
+  ``meshvae_lib.paper``; ``table1_converged``, ``table2_converged`` and ``table3_converged`` are
+  Tables 1-3 with every model trained until its validation error stops improving, their curves in
+  ``<table>_converged_curves.png`` and in ``results.json``; ``noise_diversity`` (the lesson on when
+  RIMD wins, notebook 09) is trained that way only), plus renderings: ``generation_meshes.png`` (generated meshes over
   their nearest training meshes), ``interpolation_meshes.png`` (Fig. 4), ``exploration_level1.png``
   and ``exploration_level2.png`` (Fig. 8);
 - ``summary.md``: all tables, the settings and the run times; ``results.json``: the numbers.
@@ -40,15 +41,21 @@ from meshvae_lib import paper  # noqa: E402
 
 SHORT = {
     "table1": paper.latent_size_table,
+    "table1_converged": lambda settings, cache: paper.latent_size_table(
+        settings=dataclasses.replace(settings, converge=True), cache=cache),
     "table2": paper.feature_table,
     "table2_converged": lambda settings, cache: paper.feature_table(
         settings=dataclasses.replace(settings, converge=True), cache=cache),
     "table3": paper.robustness_table,
+    "table3_converged": lambda settings, cache: paper.robustness_table(
+        settings=dataclasses.replace(settings, converge=True), cache=cache),
     "loss": paper.loss_table,
     "embedding": paper.embedding_table,
     "generation": paper.generation_table,
     "interpolation": paper.interpolation_table,
     "exploration": paper.exploration_table,
+    "noise_diversity": lambda settings, cache: paper.noise_diversity_table(
+        settings=dataclasses.replace(settings, converge=True), cache=cache),
 }
 
 

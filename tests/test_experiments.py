@@ -352,3 +352,39 @@ def test_converged_feature_table_trains_each_model_until_its_validation_error_st
     from meshvae_lib.paper.plots import plot_validation_curves
 
     assert len(plot_validation_curves(t).axes) == 1 and t.plot().axes
+
+
+def test_converged_tables_1_and_3_keep_a_curve_per_model(coll):
+    import dataclasses
+
+    s = dataclasses.replace(SETTINGS, converge=True, converge_epochs=30, patience=5)
+    t1 = paper.latent_size_table([coll], latent_dims=(4, 8), settings=s, cache={})
+    assert t1.name == "table1_latent_size_converged"
+    assert set(t1.data["validation_curves"]["ellipsoids"]) == {"D=4", "D=8"}
+    t3 = paper.robustness_table(_make, references=(0, 4), resolutions=(50,), settings=s, cache={})
+    assert t3.name == "table3_robustness_converged" and len(t3.data["validation_curves"]) == 2
+    for t in (t1, t3):
+        for kinds in t.data["validation_curves"].values():
+            for c in kinds.values():
+                assert c["chosen"] == c["epochs"][int(np.argmin(c["val_mse"]))] and c["epochs"][-1] <= 30
+        assert any("trained until its validation MSE" in n for n in t.notes) and t.plot().axes
+
+
+def test_noise_diversity_table_measures_noise_and_the_floor(monkeypatch):
+    """The knobs' table on a tiny SCAPE-like body: the noise column is sqrt(8/pi) x the level (the mean
+    length of a 3D Gaussian step), the ratios are the errors over PCA's, PCA's error grows with the
+    noise on the held-out meshes, and levels out of range are refused with their value."""
+    s = paper.ExperimentSettings.quick(max_meshes=20, train_steps=4, min_epochs=2, max_epochs=2, latent_dim=4)
+    t = paper.noise_diversity_table(diversities=(1.0,), noise_levels=(0.0, 3e-3), settings=s, cache={})
+    rows = t.as_dicts()
+    assert [(r["diversity"], r["noise"]) for r in rows] == [(1.0, 0.0), (1.0, 3e-3)]
+    for r in rows:
+        assert r["noise / diagonal"] == pytest.approx(np.sqrt(8 / np.pi) * r["noise"], rel=1e-12)
+        assert r["rimd / PCA"] == pytest.approx(r["ours rimd"] / r["PCA coords"], rel=1e-12)
+        assert r["coords / PCA"] == pytest.approx(r["ours coords"] / r["PCA coords"], rel=1e-12)
+        assert _finite_positive([r["ours coords"], r["ours rimd"], r["ours rimd, Gauss-Newton"]])
+    assert rows[1]["PCA coords"] > rows[0]["PCA coords"]
+    with pytest.raises(ValueError, match="noise levels must lie in \\[0, 0.1\\), got -0.1"):
+        paper.noise_diversity_table(noise_levels=(-0.1,), settings=s)
+    with pytest.raises(ValueError, match="diversities must lie in \\[0, 2\\], got 3"):
+        paper.noise_diversity_table(diversities=(3,), settings=s)

@@ -18,6 +18,7 @@ function                      module                experiment
 ``generation_table``          ``generation``        Sec. 5.2: generation, nearest neighbours, conditional generation
 ``interpolation_table``       ``interpolation``     Sec. 5.3 / Figs. 4 and 6: latent vs RIMD vs coordinate interpolation
 ``exploration_table``         ``exploration``       Sec. 5.5 / Fig. 8: what the first latent dimensions control
+``noise_diversity_table``     ``noise_diversity``   not the paper's: when RIMD wins (pose diversity, capture noise)
 ============================  ====================  ===========================================================
 
 The other modules: ``settings`` (:class:`ExperimentSettings`, the paper's numbers ``PAPER``),
@@ -44,6 +45,7 @@ from meshvae_lib.paper.interpolation import interpolation_table
 from meshvae_lib.paper.latent_size import latent_size_table
 from meshvae_lib.paper.linear_floor import informative_rows, linear_floor
 from meshvae_lib.paper.loss import loss_table
+from meshvae_lib.paper.noise_diversity import noise_diversity_table
 from meshvae_lib.paper.protocol import collection_fingerprint, load_collection
 from meshvae_lib.paper.robustness import robustness_table
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings
@@ -65,6 +67,7 @@ __all__ = [
     "generation_table",
     "interpolation_table",
     "exploration_table",
+    "noise_diversity_table",
     "ALL_EXPERIMENTS",
     "definition_fingerprint",
     "RecordedResults",
@@ -81,4 +84,5 @@ ALL_EXPERIMENTS = (
     generation_table,
     interpolation_table,
     exploration_table,
+    noise_diversity_table,
 )

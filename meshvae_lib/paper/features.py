@@ -8,24 +8,14 @@ from typing import Sequence
 from meshvae_lib.model.evaluation import evaluate_model
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from meshvae_lib.paper.linear_floor import FLOOR_COLUMNS, floor_cells, linear_floor
-from meshvae_lib.paper.protocol import (available, load_collection, name_of, registry_names, timed,
-                                        train_model)
+from meshvae_lib.paper.protocol import (available, convergence_note, converged_name, load_collection, name_of,
+                                        registry_names, timed, train_model, validation_curve)
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
 __all__ = ["feature_table"]
 
 logger = logging.getLogger(__name__)
-
-
-def _curve(model, s) -> dict:
-    """A converged model's validation curve: ``epochs``, ``val_mse`` (lists), ``chosen`` (the best
-    epoch, which the model was retrained for) and ``flat`` (the run stopped after ``patience`` epochs
-    without improvement, not at the epoch limit)."""
-    history = model.selection_["history"]
-    epochs = [int(h["epoch"]) for h in history]
-    return {"epochs": epochs, "val_mse": [float(h["val_mse"]) for h in history], "chosen": int(model.train_epochs_),
-            "flat": bool(epochs[-1] - int(model.train_epochs_) >= s.patience and epochs[-1] < s.converge_epochs)}
 
 
 @timed
@@ -50,10 +40,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
     cols = (["collection [N]"] + [f"ours {k}" for k in kinds] + (["ours rimd, Gauss-Newton"] if gn else [])
             + list(FLOOR_COLUMNS) + ["RIMD vs coords", "RIMD vs aligned"]
             + [f"paper {k}" for k in ("coords", "aligned", "rimd")])
-    name, title = "table2_features", "Table 2: held-out per-vertex error by input feature"
-    if s.converge:
-        name, title = name + "_converged", title + ", every model trained until its validation error stops improving"
-    table = ExperimentTable(name, title, cols)
+    table = ExperimentTable(*converged_name("table2_features", "Table 2: held-out per-vertex error by input feature", s), cols)
     table.data["errors"] = {}
     table.data["linear_floor"] = {}
     for entry in available(collections):
@@ -64,7 +51,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
                 for k, m in models.items()}
         table.data["errors"][name] = errs
         if s.converge:
-            table.data.setdefault("validation_curves", {})[name] = {k: _curve(m, s) for k, m in models.items()}
+            table.data.setdefault("validation_curves", {})[name] = {k: validation_curve(m, s) for k, m in models.items()}
         floor = table.data["linear_floor"][name] = linear_floor(coll.vertices, s.holdout_every)
         gn_cell = []
         if gn:
@@ -91,12 +78,7 @@ def feature_table(collections: Sequence[str] | None = None, kinds=FEATURE_KINDS,
                        " on it is a training residual, and the row says nothing about a representation"
                        " (not informative: left out of any summary of the ordering).")
     if s.converge:
-        open_ended = [f"{c} {k}" for c, kinds_ in table.data["validation_curves"].items() for k, cv in kinds_.items() if not cv["flat"]]
-        table.notes.append(f"Every model trained until its validation MSE (every 8th training mesh) did not improve for"
-                           f" {s.patience} epochs (at most {s.converge_epochs}), then retrained on all training meshes"
-                           " for the best number of epochs; the curves are in data['validation_curves'] ("
-                           + ("all flat at the end)" if not open_ended else
-                              "still falling at the last epoch: " + ", ".join(open_ended) + ")") + ".")
+        table.notes.append(convergence_note(table, s))
     if gn:
         table.notes.append("'ours rimd, Gauss-Newton': the same RIMD model, each held-out code refined by the library's"
                            " default inference (4 Gauss-Newton steps on the vertex error from the encoder's mean,"

@@ -195,6 +195,32 @@ def plot_validation_curves(table):
     return fig
 
 
+def plot_noise_diversity(table):
+    """When RIMD wins: each model's held-out error over PCA on coordinates against capture noise, one
+    line per pose diversity and one panel per model; the dashed line is PCA (below it, the model wins)."""
+    rows = table.as_dicts()
+    levels = sorted({r["noise"] for r in rows})
+    panels = (("coords / PCA", "coordinates (encoder)"), ("rimd / PCA", "RIMD (the paper's encoder)"),
+              ("rimd, Gauss-Newton / PCA", "RIMD (default inference)"))
+    fig = _figure(10.0, 3.4)
+    for i, (col, title) in enumerate(panels):
+        ax = fig.add_subplot(1, len(panels), i + 1, sharey=fig.axes[0] if i else None)
+        for d in sorted({r["diversity"] for r in rows}):
+            ys = [next(float(r[col]) for r in rows if r["diversity"] == d and r["noise"] == n) for n in levels]
+            ax.plot(range(len(levels)), ys, "o-", label=f"pose diversity {d:g}")
+        ax.axhline(1.0, color="k", ls="--", lw=1, label="PCA on coordinates")
+        ax.set_yscale("log")
+        ax.set_xticks(range(len(levels)))
+        ax.set_xticklabels([f"{n:g}" for n in levels], fontsize=8)
+        ax.set_xlabel("capture noise (fraction of the diagonal)", fontsize=8)
+        ax.set_title(title, fontsize=9)
+        if i == 0:
+            ax.set_ylabel("held-out error / PCA's", fontsize=8)
+    fig.axes[-1].legend(fontsize=7)
+    fig.suptitle(table.title, fontsize=9)
+    return fig
+
+
 #: experiment (table name) -> its plot.
 PLOTS = {
     "table1_latent_size": plot_latent_size,
@@ -206,6 +232,10 @@ PLOTS = {
     "generation": plot_generation,
     "interpolation": plot_interpolation,
     "exploration": plot_exploration,
+    "noise_diversity": plot_noise_diversity,
+    "noise_diversity_converged": plot_noise_diversity,
+    "table1_latent_size_converged": plot_latent_size,
+    "table3_robustness_converged": plot_robustness,
 }
 
 

@@ -148,6 +148,33 @@ def train_model(coll: MeshCollection, settings: ExperimentSettings, cache: dict 
     return model
 
 
+def validation_curve(model, settings: ExperimentSettings) -> dict:
+    """A model trained with ``settings.converge``: its validation curve, ``epochs`` and ``val_mse``
+    (lists), ``chosen`` (the best epoch, which the model was retrained for) and ``flat`` (the run
+    stopped after ``patience`` epochs without improvement, not at the epoch limit)."""
+    history = model.selection_["history"]
+    epochs = [int(h["epoch"]) for h in history]
+    return {"epochs": epochs, "val_mse": [float(h["val_mse"]) for h in history], "chosen": int(model.train_epochs_),
+            "flat": bool(epochs[-1] - int(model.train_epochs_) >= settings.patience and epochs[-1] < settings.converge_epochs)}
+
+
+def converged_name(name: str, title: str, settings: ExperimentSettings) -> tuple[str, str]:
+    """A table's name and title, marked when ``settings.converge`` trains every model to convergence."""
+    if settings.converge:
+        return name + "_converged", title + ", every model trained until its validation error stops improving"
+    return name, title
+
+
+def convergence_note(table, settings: ExperimentSettings) -> str:
+    """The note of a converged table: how its models were trained and which curves, if any, ended at the
+    epoch limit (``table.data["validation_curves"]``: row -> model -> :func:`validation_curve`)."""
+    open_ended = [f"{c} {k}" for c, kinds in table.data["validation_curves"].items() for k, cv in kinds.items() if not cv["flat"]]
+    return (f"Every model trained until its validation MSE (every 8th training mesh) did not improve for"
+            f" {settings.patience} epochs (at most {settings.converge_epochs}), then retrained on all training meshes"
+            " for the best number of epochs; the curves are in data['validation_curves'] ("
+            + ("all flat at the end)" if not open_ended else "still falling at the last epoch: " + ", ".join(open_ended) + ")") + ".")
+
+
 def safe_reference(index: int, n: int, every: int) -> int:
     """``index`` clipped to the collection and moved off held-out meshes."""
     i = int(min(max(index, 0), n - 1))

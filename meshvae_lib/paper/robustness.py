@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from meshvae_lib.model.evaluation import evaluate_model
 from meshvae_lib.paper.linear_floor import FLOOR_COLUMNS, floor_cells, linear_floor
-from meshvae_lib.paper.protocol import load_collection, name_of, safe_reference, timed, train_model
+from meshvae_lib.paper.protocol import (convergence_note, converged_name, load_collection, name_of, safe_reference,
+                                        timed, train_model, validation_curve)
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings, resolve_settings
 from meshvae_lib.paper.tables import ExperimentTable
 
@@ -44,13 +45,17 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     resolutions = [int(r) for r in resolutions]
     cols = ["base mesh", "points (asked)", "points", "error", "relative error", *FLOOR_COLUMNS, "paper base", "paper points",
             "paper error"]
-    table = ExperimentTable("table3_robustness", "Table 3: held-out error vs reference mesh and mesh density", cols)
+    table = ExperimentTable(*converged_name("table3_robustness", "Table 3: held-out error vs reference mesh and mesh density", s), cols)
     runs = [(references[0], r) for r in resolutions] + [(ref, resolutions[0]) for ref in references[1:]]
     table.data["runs"] = []
     for i, (ref, res) in enumerate(runs):
         coll = load_collection(collection, s, resolution=res, cache=cache)
         r = safe_reference(ref, len(coll.vertices), s.holdout_every)
-        ev = evaluate_model(train_model(coll, s, cache, reference_index=r), coll, held_out_only=True, inference="encoder")
+        model = train_model(coll, s, cache, reference_index=r)
+        ev = evaluate_model(model, coll, held_out_only=True, inference="encoder")
+        if s.converge:
+            table.data.setdefault("validation_curves", {})[f"No. {r + 1}, {coll.vertices.shape[1]} pts"] = {
+                "rimd": validation_curve(model, s)}
         floor = linear_floor(coll.vertices, s.holdout_every)
         paper = PAPER["table3"][i] if i < len(PAPER["table3"]) else (None, None, None)
         table.rows.append([f"No. {r + 1}", res, coll.vertices.shape[1], ev["mean_vertex_error"], ev["relative_error"],
@@ -62,4 +67,6 @@ def robustness_table(collection: str = "jumping", references=(0, 5, 71), resolut
     table.data["spread"] = float(max(errs) - min(errs))
     table.notes.append(f"collection {name_of(collection)!r}; spread of our errors (max - min): {table.data['spread']:.3e}"
                        " (paper: below 1e-4, 'no visual difference').")
+    if s.converge:
+        table.notes.append(convergence_note(table, s))
     return table
