@@ -13,7 +13,10 @@ import numpy as np
 
 from data_synth.quality import bounding_box_diagonals
 
-__all__ = ["add_capture_noise"]
+__all__ = ["add_capture_noise", "with_capture_noise", "NOISE_STREAM"]
+
+#: the capture noise's random stream, apart from the generators' own (which use ``seed`` alone).
+NOISE_STREAM = 7
 
 
 def add_capture_noise(vertices, level: float, rng: np.random.Generator) -> np.ndarray:
@@ -34,3 +37,20 @@ def add_capture_noise(vertices, level: float, rng: np.random.Generator) -> np.nd
         return V.copy()
     scale = level * bounding_box_diagonals(V)
     return V + rng.normal(size=V.shape) * scale[:, None, None]
+
+
+def with_capture_noise(collection, level: float, seed: int):
+    """``collection`` (a :class:`~data_synth.collection.SynthCollection`) with capture noise, in place.
+
+    level : float >= 0, as in :func:`add_capture_noise`; seed : int >= 0, the collection's seed. The
+    noise is drawn from its own generator (``[seed, NOISE_STREAM]``), so the meshes under it are the
+    same for every level. ``extras['noise']`` records the level and, when it is not 0,
+    ``extras['exact']`` keeps the exact meshes ``(N, V, 3) float64``. Returns the collection.
+    """
+    if level:
+        exact = collection.vertices
+        collection.vertices = add_capture_noise(exact, float(level), np.random.default_rng([int(seed), NOISE_STREAM]))
+        collection.extras["exact"] = exact
+        collection.description += f", capture noise {level:g} of the diagonal"
+    collection.extras["noise"] = float(level)
+    return collection

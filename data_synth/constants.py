@@ -140,6 +140,17 @@ FACE_VARIANTS = 10
 FACE_MIN_INTENSITY = 0.6
 FACE_WEIGHT_JITTER = 0.2
 FACE_SPEECH_JAW = 0.06
+#: every mesh also moves every other blendshape by up to FACE_SPEECH_WEIGHT (speech and mood: a face in
+#: a capture is never still), rolls its lips by up to FACE_LIP_ROLL radians at weight 1 (an expression's
+#: "lip_roll" weight scales it), slides its jaw sideways by up to FACE_JAW_SIDE radians, and turns its
+#: head on the neck about FACE_NECK_PIVOT by independent yaw, pitch (up, down) and roll of up to
+#: FACE_HEAD_TURN radians: the head's turn times the expression is what no linear basis reproduces
+FACE_SPEECH_WEIGHT = 0.35
+FACE_ASYMMETRY = 0.3
+FACE_LIP_ROLL = 0.5
+FACE_JAW_SIDE = 0.03
+FACE_NECK_PIVOT = (0.0, -0.11, -0.025)
+FACE_HEAD_TURN = (0.6, 0.3, 0.15, 0.2)
 FACE_BLEND_RADIUS = 0.02
 
 # --- flag and bar -----------------------------------------------------------------------------

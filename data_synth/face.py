@@ -23,17 +23,17 @@ from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 
 __all__ = ["make_face", "face_template", "blendshapes", "EXPRESSIONS"]
 
-#: expression -> blendshape weights at its peak ("jaw_open": the jaw's rotation, as a fraction of
-#: ``FACE_JAW_ANGLE``, not a blendshape)
+#: expression -> blendshape weights at its peak ("jaw_open" and "lip_roll" are rotations, as fractions
+#: of ``FACE_JAW_ANGLE`` and ``FACE_LIP_ROLL``, not blendshapes)
 EXPRESSIONS = {
-    "smile": {"smile": 1.0, "cheek_raise": 0.8},
-    "laugh": {"smile": 1.0, "cheek_raise": 1.0, "jaw_open": 0.6},
-    "surprise": {"jaw_open": 0.9, "brow_raise": 1.0},
-    "angry": {"brow_lower": 1.0, "mouth_corners_down": 0.5, "lip_press": 0.6},
-    "sad": {"mouth_corners_down": 1.0, "brow_inner_up": 1.0},
-    "kiss": {"pucker": 1.0},
-    "puff": {"cheek_puff": 1.0},
-    "shout": {"jaw_open": 1.0, "brow_lower": 0.6, "mouth_stretch": 0.6},
+    "smile": {"smile": 1.0, "cheek_raise": 0.8, "squint": 0.4},
+    "laugh": {"smile": 1.0, "cheek_raise": 1.0, "squint": 0.9, "jaw_open": 0.7},
+    "surprise": {"jaw_open": 1.0, "brow_raise": 1.0, "eyes_wide": 1.0},
+    "angry": {"brow_lower": 1.0, "squint": 0.6, "mouth_corners_down": 0.4, "lip_press": 0.6},
+    "sad": {"mouth_corners_down": 1.0, "brow_inner_up": 1.0, "lip_roll": 0.4},
+    "kiss": {"pucker": 1.0, "lip_roll": 1.0},
+    "puff": {"cheek_puff": 1.0, "lip_press": 0.5},
+    "shout": {"jaw_open": 1.0, "brow_lower": 0.7, "mouth_stretch": 1.0},
 }
 
 
@@ -94,7 +94,7 @@ def _jaw_weights(V: np.ndarray):
 
 def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1 (the jaw is not
-    one: it turns about its hinge, :func:`_jaw_rotation`)."""
+    one: it turns about its hinge in :func:`_expression_mesh`)."""
     x = V[:, 0]
     sx = np.tanh(x / 0.012)  # a smooth 'which side' (a sign would tear the midline)
     out = {}
@@ -115,6 +115,11 @@ def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     across = np.tanh((V[:, 1] + 0.044) / 0.006)
     out["lip_press"] = np.stack([np.zeros_like(x), -0.002 * across,
                                  -0.002 * np.ones_like(x)], 1) * lips[:, None]
+    # the eyelids: above each eye the skin moves down and below it up (squint), or the other way
+    above = sum(_gauss(V, (s * 0.032, 0.032, 0.09), (0.016, 0.007, 0.02)) for s in (1, -1))
+    below = sum(_gauss(V, (s * 0.032, 0.007, 0.09), (0.016, 0.007, 0.02)) for s in (1, -1))
+    out["squint"] = np.array([0.0, -0.003, 0.0]) * above[:, None] + np.array([0.0, 0.002, 0.001]) * below[:, None]
+    out["eyes_wide"] = np.array([0.0, 0.005, 0.001]) * above[:, None] + np.array([0.0, -0.002, 0.0]) * below[:, None]
     puff = sum(_gauss(V, (s * 0.045, -0.035, 0.055), (0.018, 0.02, 0.025)) for s in (1, -1))
     normals_out = V - np.array([0.0, -0.03, 0.0])
     normals_out /= np.linalg.norm(normals_out, axis=1, keepdims=True)
@@ -138,47 +143,87 @@ def _identity(V: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return V
 
 
-def _jaw_rotation(V: np.ndarray, angle: float) -> np.ndarray:
-    """Open the jaw: every vertex turned about the hinge (near the ears) by ``angle`` times its jaw
-    weight (1 on the chin, fading to 0 above the mouth and into the neck): a rotation, not a
-    displacement scaled with the angle. V (n, 3) float64 -> (n, 3) float64."""
-    pivot, w = _jaw_weights(V)
-    rotvec = np.zeros((len(V), 3))
-    rotvec[:, 0] = angle * w
-    return Rotation.from_rotvec(rotvec).apply(V - pivot) + pivot
+def _rotate_weighted(V: np.ndarray, pivot, rotvec, w: np.ndarray) -> np.ndarray:
+    """Every vertex turned about ``pivot (3,)`` by the rotation ``w_i * rotvec`` (a rotation vector
+    ``(3,)``, radians): weight 1 turns rigidly, 0 stays, in between bends smoothly. V (n, 3) -> (n, 3)."""
+    pivot = np.asarray(pivot, dtype=np.float64)
+    return Rotation.from_rotvec(w[:, None] * np.asarray(rotvec, dtype=np.float64)).apply(V - pivot) + pivot
+
+
+def _head_weights(V: np.ndarray) -> np.ndarray:
+    """How far each vertex follows the head's turn ``(n,)``: 1 on the head (chin and jaw included),
+    fading to 0 down the neck along a plane that tilts forward (the chin sits above the neck)."""
+    return _smoothstep((V[:, 1] + 0.5 * V[:, 2] + 0.19) / 0.1)
+
+
+def _lip_roll(V: np.ndarray, angle: float) -> np.ndarray:
+    """Roll both lips about their roots: outward (``angle > 0``, the upper lip curls up, the lower
+    down, as in a kiss) or inward (``angle < 0``, lips pressed thin). A rotation per lip, radians."""
+    upper = _gauss(V, (0.0, -0.034, 0.094), (0.024, 0.008, 0.014))
+    lower = _gauss(V, (0.0, -0.054, 0.09), (0.022, 0.009, 0.014))
+    V = _rotate_weighted(V, (0.0, -0.036, 0.078), (-angle, 0.0, 0.0), upper)
+    return _rotate_weighted(V, (0.0, -0.052, 0.076), (angle, 0.0, 0.0), lower)
+
+
+def _expression_mesh(V0: np.ndarray, shapes: dict, weights: dict, intensity: float,
+                     rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """One mesh ``(n, 3)`` of an expression and its head pose ``(yaw, pitch, roll)`` in radians.
+
+    The expression's blendshapes at ``intensity`` (each weight jittered by ``FACE_WEIGHT_JITTER``)
+    plus every other blendshape a little (speech and mood: up to ``FACE_SPEECH_WEIGHT``), then the
+    rotations: the lips roll, the jaw opens and slides sideways about its hinge, and the head turns
+    on the neck (yaw, pitch and roll drawn independently within ``FACE_HEAD_TURN``)."""
+    field = np.zeros_like(V0)
+    extra = {b: rng.uniform(0.0, C.FACE_SPEECH_WEIGHT) for b in sorted(shapes) if b not in weights}
+    jaw = rng.uniform(0.0, C.FACE_SPEECH_JAW)
+    roll = rng.uniform(-1.0, 1.0) * C.FACE_LIP_ROLL * C.FACE_SPEECH_WEIGHT
+    for b, w in weights.items():
+        k = w * intensity * (1.0 + rng.uniform(-1, 1) * C.FACE_WEIGHT_JITTER)
+        if b == "jaw_open":
+            jaw += k * C.FACE_JAW_ANGLE
+        elif b == "lip_roll":
+            roll += k * C.FACE_LIP_ROLL
+        else:
+            extra[b] = extra.get(b, 0.0) + k
+    side = np.tanh(V0[:, 0] / 0.012)[:, None]
+    for b, k in extra.items():  # each side of the face a little its own (no face is symmetric)
+        field += k * (1.0 + rng.uniform(-1.0, 1.0) * C.FACE_ASYMMETRY * side) * shapes[b]
+    V = _lip_roll(V0 + field, roll)
+    hinge, w_jaw = _jaw_weights(V0)
+    slide = rng.uniform(-1.0, 1.0) * C.FACE_JAW_SIDE
+    V = _rotate_weighted(V, hinge, (min(jaw, C.FACE_JAW_ANGLE), slide, 0.0), w_jaw)
+    yaw_max, pitch_up, pitch_down, roll_max = C.FACE_HEAD_TURN
+    pose = np.array([rng.uniform(-yaw_max, yaw_max), rng.uniform(-pitch_up, pitch_down),
+                     rng.uniform(-roll_max, roll_max)])
+    V = _rotate_weighted(V, C.FACE_NECK_PIVOT, pose[[1, 0, 2]], _head_weights(V0))
+    return V, pose
 
 
 def make_face(seed: int = 0, resolution: int | None = None,
               variants_per_expression: int = C.FACE_VARIANTS) -> SynthCollection:
     """Every expression ``variants_per_expression`` times, each an independent draw: its intensity
-    (``FACE_MIN_INTENSITY`` to 1), every blendshape weight jittered by up to ``FACE_WEIGHT_JITTER``,
-    and the jaw opened by the expression's angle plus up to ``FACE_SPEECH_JAW`` radians (speech),
-    at most ``FACE_JAW_ANGLE``. Labels ``expression``, ``variant``, ``intensity_pct``."""
+    (``FACE_MIN_INTENSITY`` to 1), its blendshape weights, the rest of the face's small motions and
+    the head's turn on the neck (:func:`_expression_mesh`), as a performer's face moves in a capture.
+    Labels ``expression``, ``variant``, ``intensity_pct`` and ``head_yaw_deg``."""
     V0, F = face_template(resolution)
     rng = np.random.default_rng(seed)
     V0 = _identity(np.array(V0), rng)
     shapes = blendshapes(V0)
-    chunks, names, expr, variant, inten = [], [], [], [], []
+    chunks, names, expr, variant, inten, yaw = [], [], [], [], [], []
     for e, weights in EXPRESSIONS.items():
         for i in range(variants_per_expression):
             intensity = rng.uniform(C.FACE_MIN_INTENSITY, 1.0)
-            field = np.zeros_like(V0)
-            jaw = rng.uniform(0.0, C.FACE_SPEECH_JAW)
-            for b, w in weights.items():
-                k = w * intensity * (1.0 + rng.uniform(-1, 1) * C.FACE_WEIGHT_JITTER)
-                if b == "jaw_open":
-                    jaw += k * C.FACE_JAW_ANGLE
-                else:
-                    field += k * shapes[b]
-            chunks.append(_jaw_rotation(V0 + field, min(jaw, C.FACE_JAW_ANGLE)))
+            V, pose = _expression_mesh(V0, shapes, weights, intensity, rng)
+            chunks.append(V)
             names.append(f"{e}_{i:02d}")
             expr.append(e)
             variant.append(i)
             inten.append(int(round(100 * intensity)))
+            yaw.append(int(round(np.degrees(pose[0]))))
     return SynthCollection(
         vertices=np.stack(chunks), faces=np.array(F), names=names,
         labels={"expression": np.array(expr), "variant": np.array(variant, dtype=np.int64),
-                "intensity_pct": np.array(inten, dtype=np.int64)},
-        description="a head with expressions (blendshapes and a rotating jaw), every mesh its own intensity",
+                "intensity_pct": np.array(inten, dtype=np.int64), "head_yaw_deg": np.array(yaw, dtype=np.int64)},
+        description="a head with expressions (blendshapes, rolling lips and a rotating jaw) turning on its neck",
         extras={"rest": V0, "blendshape_names": sorted(shapes)},  # rest: this seed's neutral
     )

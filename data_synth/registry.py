@@ -11,17 +11,11 @@ import numbers
 from dataclasses import dataclass
 from typing import Callable
 
-import numpy as np
-
 from data_synth import bar, bodies, face, flag, hand
-from data_synth.capture_noise import add_capture_noise
+from data_synth.capture_noise import with_capture_noise
 from data_synth.collection import SynthCollection
 
 __all__ = ["COLLECTIONS", "CollectionSpec", "list_collections", "make_collection", "SynthCollection"]
-
-
-#: the capture noise's random stream, apart from the generators' own (which use ``seed`` alone).
-NOISE_STREAM = 7
 
 
 @dataclass(frozen=True)
@@ -98,10 +92,4 @@ def make_collection(name: str, seed: int = 0, resolution: int | None = None,
     if isinstance(noise, bool) or not isinstance(noise, numbers.Real) or not 0 <= noise < float("inf"):
         raise ValueError(f"noise must be a finite number >= 0, got {noise!r}")
     collection = COLLECTIONS[name].build(seed=int(seed), resolution=resolution)
-    if noise:
-        exact = collection.vertices
-        collection.vertices = add_capture_noise(exact, float(noise), np.random.default_rng([int(seed), NOISE_STREAM]))
-        collection.extras["exact"] = exact
-        collection.description += f", capture noise {noise:g} of the diagonal"
-    collection.extras["noise"] = float(noise)
-    return collection
+    return with_capture_noise(collection, float(noise), int(seed))

@@ -120,23 +120,45 @@ def test_group_labels_are_complete(name, column, groups):
 
 
 def test_face_intensity_scales_the_expression(monkeypatch):
-    """Every mesh moves (no neutral copies); without the weight jitter and the speech jaw, an
-    expression without the jaw is its blendshape field times the intensity label, exactly."""
+    """Every mesh moves (no neutral copies); with the jitter, the speech and mood motions, the
+    asymmetry and the head's turn switched off, an expression without rotations (no jaw, no lip roll)
+    is its blendshape field times the intensity label, exactly."""
     col = make_collection("face", resolution=SMALL)
     disp = np.linalg.norm(col.vertices - col.extras["rest"], axis=-1).max(axis=1)
     assert disp.min() > 0.0015 and disp.max() > 0.003
     from data_synth import constants as C
 
-    monkeypatch.setattr(C, "FACE_WEIGHT_JITTER", 0.0)
-    monkeypatch.setattr(C, "FACE_SPEECH_JAW", 0.0)
+    for knob in ("FACE_WEIGHT_JITTER", "FACE_SPEECH_JAW", "FACE_SPEECH_WEIGHT", "FACE_ASYMMETRY", "FACE_JAW_SIDE"):
+        monkeypatch.setattr(C, knob, 0.0)
+    monkeypatch.setattr(C, "FACE_HEAD_TURN", (0.0, 0.0, 0.0, 0.0))
     col = make_collection("face", resolution=SMALL)
     move = col.vertices - col.extras["rest"]
-    for e in ("smile", "sad", "kiss", "puff"):
+    for e in ("smile", "puff"):
         k = np.flatnonzero(col.labels["expression"] == e)
         ratio = move[k] / np.maximum(col.labels["intensity_pct"][k], 1)[:, None, None]
         # equal up to the label's rounding to a whole percent (0.5 / 60 of the field each, so 2% between two)
         np.testing.assert_allclose(ratio, np.broadcast_to(ratio[:1], ratio.shape), atol=0.02 * np.abs(ratio).max())
         assert np.abs(move[k]).max() > 1e-3, e
+
+
+def test_face_head_turns_on_a_fixed_neck():
+    """The head turns by its yaw label (measured by a rigid fit of the cranium to the neutral head,
+    to a degree after rounding and the other small motions) while the bottom of the neck stays put;
+    the yaws span both sides."""
+    from meshvae_lib.geometry.alignment import rigid_transform
+
+    col = make_collection("face", resolution=SMALL)
+    rest = col.extras["rest"]
+    crown = rest[:, 1] > 0.06  # the top of the skull: no expression moves it
+    neck = rest[:, 1] + 0.5 * rest[:, 2] < -0.2
+    assert crown.sum() > 10 and neck.sum() > 10
+    yaw = col.labels["head_yaw_deg"]
+    assert yaw.min() < -20 and yaw.max() > 20
+    for V, label in zip(col.vertices, yaw):
+        R, _ = rigid_transform(rest[crown], V[crown])
+        measured = np.degrees(np.arctan2(R[0, 2], R[2, 2]))
+        assert abs(measured - label) < 3.0, (measured, label)
+        assert np.abs(V[neck] - rest[neck]).max() < 1e-3
 
 
 def test_sequences_are_sampled_sparsely_but_continuously():

@@ -42,12 +42,11 @@ def _collection(diversity: float, noise: float, settings: ExperimentSettings):
     """The SCAPE-like collection at ``diversity`` with capture noise ``noise`` (its own random stream,
     so every noise level has the same meshes under it)."""
     from data_synth.bodies import make_scape
-    from data_synth.capture_noise import add_capture_noise
-    from data_synth.registry import NOISE_STREAM
+    from data_synth.capture_noise import with_capture_noise
 
-    c = make_scape(seed=settings.seed, resolution=settings.resolution, diversity=diversity)
-    V = add_capture_noise(c.vertices, noise, np.random.default_rng([settings.seed, NOISE_STREAM]))
-    return SimpleNamespace(name=f"scape d={diversity:g} noise={noise:g}", vertices=V, faces=c.faces,
+    c = with_capture_noise(make_scape(seed=settings.seed, resolution=settings.resolution, diversity=diversity),
+                           noise, settings.seed)
+    return SimpleNamespace(name=f"scape d={diversity:g} noise={noise:g}", vertices=c.vertices, faces=c.faces,
                            names=c.names, labels=c.labels, description=c.description)
 
 
