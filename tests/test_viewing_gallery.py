@@ -19,6 +19,10 @@ def test_the_most_deformed_mesh_of_each_group_in_order_of_appearance():
     groups = np.array(["b", "b", "a", "a", "c", "c"])
     assert gallery_indices(V, 8, groups).tolist() == [1, 2, 4]
     assert gallery_indices(V, 2, groups).tolist() == [1, 2]
+    # a score picks the member with the highest one instead of the most deformed
+    assert gallery_indices(V, 8, groups, score=-np.arange(6.0)).tolist() == [0, 2, 4]
+    with pytest.raises(ValueError, match=r"score must be 6 finite numbers, one per mesh, got shape \(5,\)"):
+        gallery_indices(V, 8, groups, score=np.zeros(5))
     with pytest.raises(ValueError, match=r"one label per mesh \(6\), got shape \(5,\)"):
         gallery_indices(V, 2, groups[:5])
     with pytest.raises(ValueError, match="n_panels must be an integer >= 1, got 0"):
@@ -29,7 +33,8 @@ def test_captions_show_categories_numbers_with_units_and_the_frame_when_little_e
     labels = {"motion": np.array(["jumping_jacks", "run"]), "frame": np.array([3, 4])}
     assert mesh_caption(labels, 0, "m0") == "jumping jacks\nframe 3"
     labels = {"bend_deg": np.array([30, 45]), "wind_pct": np.array([10, 20])}
-    assert mesh_caption(labels, 1, "m1") == "bend 45°, wind 20%"
+    assert mesh_caption(labels, 1, "m1") == "bend 45°\nwind 20%"
+    assert mesh_caption({"head_yaw_deg": np.array([-26])}, 0, "m") == "head yaw -26°"
     assert mesh_caption({}, 0, "pose_007") == "pose_007"
 
 

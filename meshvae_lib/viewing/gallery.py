@@ -18,14 +18,15 @@ __all__ = ["gallery_indices", "mesh_caption", "angular_stripes", "LABEL_UNITS"]
 LABEL_UNITS = {"_deg": "°", "_pct": "%"}
 
 
-def gallery_indices(vertices, n_panels: int, groups=None) -> np.ndarray:
+def gallery_indices(vertices, n_panels: int, groups=None, score=None) -> np.ndarray:
     """Which meshes to show in a gallery of ``n_panels`` panels.
 
     vertices : (M, n, 3) float, the collection's meshes; n_panels : int >= 1; groups : (M,) labels
-    or None. Without groups: ``n_panels`` evenly spaced indices from the first mesh to the last.
-    With groups: for each group in order of first appearance, the mesh farthest (mean vertex
-    distance) from the collection's first mesh -- the most deformed member -- and at most
-    ``n_panels`` of them. Returns (P,) int64 indices.
+    or None; score : (M,) float or None. Without groups: ``n_panels`` evenly spaced indices from the
+    first mesh to the last. With groups: for each group in order of first appearance, the member
+    with the highest ``score`` -- by default the mesh farthest (mean vertex distance) from the
+    collection's first mesh, the most deformed member -- and at most ``n_panels`` of them. Returns
+    (P,) int64 indices.
     """
     V = check_vertices(vertices, "vertices", batch=True)
     if len(V) == 0:
@@ -36,7 +37,12 @@ def gallery_indices(vertices, n_panels: int, groups=None) -> np.ndarray:
     groups = np.asarray(groups)
     if groups.shape != (len(V),):
         raise ValueError(f"groups must have one label per mesh ({len(V)}), got shape {groups.shape}")
-    away = np.linalg.norm(V - V[0], axis=-1).mean(axis=1)  # (M,)
+    if score is None:
+        away = np.linalg.norm(V - V[0], axis=-1).mean(axis=1)  # (M,)
+    else:
+        away = np.asarray(score, dtype=np.float64)
+        if away.shape != (len(V),) or not np.isfinite(away).all():
+            raise ValueError(f"score must be {len(V)} finite numbers, one per mesh, got shape {away.shape}")
     picks = []
     for g in dict.fromkeys(groups.tolist()):
         members = np.flatnonzero(groups == g)
@@ -49,15 +55,13 @@ def mesh_caption(labels: Mapping, i: int, name: str) -> str:
 
     labels : {label name: (M,) values}; i : the mesh index; name : the mesh's name, used when it
     has no label to show. Categorical (string) labels one per line with underscores as spaces;
-    numeric labels whose names end in a unit suffix of :data:`LABEL_UNITS` (``bend_deg``) joined
-    on one line (``bend 30°``); the frame number when that gives fewer than two lines.
+    numeric labels whose names end in a unit suffix of :data:`LABEL_UNITS` (``bend_deg``) one per
+    line, underscores as spaces (``bend 30°``); the frame number when that gives fewer than two lines.
     """
     values = {k: labels[k][i] for k in labels}
     lines = [str(v).replace("_", " ") for v in values.values() if isinstance(v, str)]
-    numbers = [f"{k[:-len(suffix)]} {v}{unit}" for k, v in values.items()
-               for suffix, unit in LABEL_UNITS.items() if k.endswith(suffix)]
-    if numbers:
-        lines.append(", ".join(numbers))
+    lines += [f"{k[:-len(suffix)].replace('_', ' ')} {v}{unit}" for k, v in values.items()
+              for suffix, unit in LABEL_UNITS.items() if k.endswith(suffix)]
     if len(lines) < 2 and "frame" in values:
         lines.append(f"frame {values['frame']}")
     return "\n".join(lines) if lines else str(name)

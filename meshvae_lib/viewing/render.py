@@ -318,7 +318,8 @@ def render_mesh_grid(
     nc = min(ncols, k)
     nr = int(math.ceil(k / nc))
     extra = 0.7 if (colorbar is not None or legend) else 0.0
-    top = (0.35 if suptitle else 0.0) + (0.25 if titles is not None else 0.0)
+    lines = max((str(t).count("\n") + 1 for t in titles), default=1) if titles is not None else 0
+    top = (0.35 if suptitle else 0.0) + (0.25 + 0.16 * max(lines - 2, 0) if titles is not None else 0.0)
     fig = MeshFigure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
     R = view_basis(view, up)
     extent = None
