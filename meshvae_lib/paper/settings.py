@@ -66,7 +66,7 @@ class ExperimentSettings:
     seed: int = 0
     embedding_steps: int = 1000
     converge: bool = False
-    converge_epochs: int = 3000
+    converge_epochs: int = 10000
     patience: int = 200
 
     @classmethod
