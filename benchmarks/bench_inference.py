@@ -1,13 +1,14 @@
 """Speed of the latent inference strategies: seconds to encode one mesh (issue 23).
 
-Loads a trained model (``--model m.pt`` with its collection ``--real NAME`` of ../shared/data, or
-trains a default RIMD model on a data_synth collection) and times ``encode_meshes`` of single
+Loads a trained model (``--model m.pt`` with its collection ``--real NAME`` of ../shared/data), or
+trains a default RIMD model on ``--real NAME`` alone or on a data_synth collection, and times ``encode_meshes`` of single
 held-out meshes with each strategy: the paper's encoder, the default Gauss-Newton (analytic
 Jacobian) and, with ``--finite-difference``, the old forward-difference fit. Medians over
 ``--repeats`` runs of each of ``--meshes`` meshes (the machines are shared and noisy).
 
     python benchmarks/feature_comparison.py --real samba --kinds rimd --save-models /tmp/models
     python benchmarks/bench_inference.py --model /tmp/models/samba_rimd.pt --real samba
+    python benchmarks/bench_inference.py --real samba --subsample 3  # trains the default model first
     python benchmarks/bench_inference.py --synth scape            # without the real data
 """
 
@@ -41,6 +42,11 @@ def main() -> None:
     if args.model:
         coll = load_real(args.real, args.subsample)
         model = load_model(args.model, coll)
+    elif args.real:
+        coll = load_real(args.real, args.subsample)
+        t0 = time.perf_counter()
+        model = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=5).fit(coll)
+        print(f"trained the default RIMD model on {args.real}/{args.subsample} in {time.perf_counter() - t0:.0f} s")
     else:
         from data_synth.registry import make_collection
 
@@ -56,7 +62,8 @@ def main() -> None:
         for _ in range(args.repeats):
             for x in V:
                 t0 = time.perf_counter()
-                model.encode_meshes(x[None], inference=method, iterations=4 if method == "gauss-newton" else 3)
+                options = {} if method == "encoder" else {"iterations": 4 if method == "gauss-newton" else 3}
+                model.encode_meshes(x[None], inference=method, **options)
                 times.append(time.perf_counter() - t0)
         extra = f", {model.last_inference_!r}" if method == "gauss-newton" else ""
         print(f"{method:18s} {statistics.median(times):8.3f} s  (min {min(times):.3f}, max {max(times):.3f}){extra}",
