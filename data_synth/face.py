@@ -92,11 +92,25 @@ def _jaw_weights(V: np.ndarray):
     return np.array([0.0, -0.01, -0.02]), below * not_neck * front
 
 
+def _side(V: np.ndarray) -> np.ndarray:
+    """A smooth 'which side' of every vertex ``(n,)``: +1 left, -1 right, through 0 on the midline
+    (a sign would tear the midline)."""
+    return np.tanh(V[:, 0] / 0.012)
+
+
+def _rig(V0: np.ndarray) -> dict:
+    """What every mesh of one neutral head ``V0 (n, 3)`` shares, computed once: ``side (n, 1)``
+    (:func:`_side`), the jaw's ``hinge (3,)`` and weights ``jaw (n,)`` and the head's weights
+    ``head (n,)``."""
+    hinge, w_jaw = _jaw_weights(V0)
+    return {"side": _side(V0)[:, None], "hinge": hinge, "jaw": w_jaw, "head": _head_weights(V0)}
+
+
 def blendshapes(V: np.ndarray) -> dict[str, np.ndarray]:
     """Displacement field ``(n_vertices, 3) float64`` of every blendshape at weight 1 (the jaw is not
     one: it turns about its hinge in :func:`_expression_mesh`)."""
     x = V[:, 0]
-    sx = np.tanh(x / 0.012)  # a smooth 'which side' (a sign would tear the midline)
+    sx = _side(V)
     out = {}
     corner = sum(_gauss(V, (s * 0.026, -0.044, 0.092), (0.014, 0.012, 0.02)) for s in (1, -1))
     out["smile"] = np.stack([0.006 * sx, 0.007 * np.ones_like(x), -0.004 * np.ones_like(x)], 1) * corner[:, None]
@@ -165,9 +179,10 @@ def _lip_roll(V: np.ndarray, angle: float) -> np.ndarray:
     return _rotate_weighted(V, (0.0, -0.052, 0.076), (angle, 0.0, 0.0), lower)
 
 
-def _expression_mesh(V0: np.ndarray, shapes: dict, weights: dict, intensity: float,
+def _expression_mesh(V0: np.ndarray, shapes: dict, rig: dict, weights: dict, intensity: float,
                      rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """One mesh ``(n, 3)`` of an expression and its head pose ``(yaw, pitch, roll)`` in radians.
+    """One mesh ``(n, 3)`` of an expression and its head pose ``(yaw, pitch, roll)`` in radians
+    (``rig``: :func:`_rig` of ``V0``).
 
     The expression's blendshapes at ``intensity`` (each weight jittered by ``FACE_WEIGHT_JITTER``)
     plus every other blendshape a little (speech and mood: up to ``FACE_SPEECH_WEIGHT``), then the
@@ -185,17 +200,15 @@ def _expression_mesh(V0: np.ndarray, shapes: dict, weights: dict, intensity: flo
             roll += k * C.FACE_LIP_ROLL
         else:
             extra[b] = extra.get(b, 0.0) + k
-    side = np.tanh(V0[:, 0] / 0.012)[:, None]
     for b, k in extra.items():  # each side of the face a little its own (no face is symmetric)
-        field += k * (1.0 + rng.uniform(-1.0, 1.0) * C.FACE_ASYMMETRY * side) * shapes[b]
+        field += k * (1.0 + rng.uniform(-1.0, 1.0) * C.FACE_ASYMMETRY * rig["side"]) * shapes[b]
     V = _lip_roll(V0 + field, roll)
-    hinge, w_jaw = _jaw_weights(V0)
     slide = rng.uniform(-1.0, 1.0) * C.FACE_JAW_SIDE
-    V = _rotate_weighted(V, hinge, (min(jaw, C.FACE_JAW_ANGLE), slide, 0.0), w_jaw)
+    V = _rotate_weighted(V, rig["hinge"], (min(jaw, C.FACE_JAW_ANGLE), slide, 0.0), rig["jaw"])
     yaw_max, pitch_up, pitch_down, roll_max = C.FACE_HEAD_TURN
     pose = np.array([rng.uniform(-yaw_max, yaw_max), rng.uniform(-pitch_up, pitch_down),
                      rng.uniform(-roll_max, roll_max)])
-    V = _rotate_weighted(V, C.FACE_NECK_PIVOT, pose[[1, 0, 2]], _head_weights(V0))
+    V = _rotate_weighted(V, C.FACE_NECK_PIVOT, pose[[1, 0, 2]], rig["head"])
     return V, pose
 
 
@@ -208,12 +221,12 @@ def make_face(seed: int = 0, resolution: int | None = None,
     V0, F = face_template(resolution)
     rng = np.random.default_rng(seed)
     V0 = _identity(np.array(V0), rng)
-    shapes = blendshapes(V0)
+    shapes, rig = blendshapes(V0), _rig(V0)
     chunks, names, expr, variant, inten, yaw = [], [], [], [], [], []
     for e, weights in EXPRESSIONS.items():
         for i in range(variants_per_expression):
             intensity = rng.uniform(C.FACE_MIN_INTENSITY, 1.0)
-            V, pose = _expression_mesh(V0, shapes, weights, intensity, rng)
+            V, pose = _expression_mesh(V0, shapes, rig, weights, intensity, rng)
             chunks.append(V)
             names.append(f"{e}_{i:02d}")
             expr.append(e)
