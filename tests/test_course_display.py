@@ -64,3 +64,18 @@ def test_real_feature_table_prints_the_recorded_kinds_the_floor_and_the_verdict(
                                 "0.25", "yes"]
     assert lines[2].split() == ["b", "2.00e-05", "1.60e-05", "7.50e-05", "-", "1.50e-05", "1.20e-05", "5.2e-06", "5.00",
                                 "linear", "data:", "not", "informative"]
+
+
+def test_span_ceiling_table_prints_the_recorded_errors_and_their_ratios_to_pca():
+    from meshvae_lib.course.display import span_ceiling_table
+
+    rows = [{"collection": "a", "n_meshes": 40, "pca_coords": 0.002, "feature_projection": 0.03, "vertex_optimal": 0.004,
+             "default": 0.005, "vertex_optimal_below_pca": 9},
+            {"collection": "b/3", "n_meshes": 12, "pca_coords": 0.02, "feature_projection": 0.07, "vertex_optimal": 0.015,
+             "default": 0.014, "vertex_optimal_below_pca": 10}]
+    lines = span_ceiling_table(rows).splitlines()
+    assert len(lines) == 3 and lines[0].split()[:3] == ["collection", "meshes", "PCA"]
+    assert lines[1].split() == ["a", "40", "2.00e-03", "3.00e-02", "4.00e-03", "5.00e-03", "|", "15.00", "2.00", "2.50",
+                                "|", "9", "of", "40"]
+    assert lines[2].split() == ["b/3", "12", "2.00e-02", "7.00e-02", "1.50e-02", "1.40e-02", "|", "3.50", "0.75", "0.70",
+                                "|", "10", "of", "12"]

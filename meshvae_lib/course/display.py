@@ -11,7 +11,7 @@ import numpy as np
 
 from meshvae_lib.tolerances import TIE_RTOL
 
-__all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table"]
+__all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table"]
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -84,4 +84,24 @@ def real_feature_table(rows) -> str:
         lines.append(f"{r['collection']:10s} {r['coords_default']:9.2e} {r['aligned_default']:9.2e} {r['default']:9.2e}"
                      f" {paper:>10s} {r['pca_coords']:10.2e} {r['pca_aligned']:9.2e} {r['floor_relative']:10.1e}"
                      f" {r['default'] / r['pca_coords']:8.2f}  {'yes' if r['informative'] else NOT_INFORMATIVE}")
+    return "\n".join(lines)
+
+
+def span_ceiling_table(rows) -> str:
+    """How good a decoder of the default form can be on real meshes, recorded
+    (``docs/results/inference_real.json``'s ``span_ceiling.rows``: dicts with ``collection``,
+    ``n_meshes``, ``pca_coords``, ``feature_projection``, ``vertex_optimal``, ``default`` (mean
+    held-out errors on the same meshes) and ``vertex_optimal_below_pca`` (how many of the meshes)),
+    written by ``benchmarks/inference_span_oracle.py``: PCA on coordinates, the held-out feature
+    projected onto the span of the training features, the span's point closest to the mesh in vertex
+    error, and the default model, each also divided by PCA. Recorded numbers, the same on every
+    machine."""
+    lines = [f"{'collection':10s} {'meshes':>6s} {'PCA coords':>10s} {'projection':>10s} {'best in span':>12s}"
+             f" {'default':>9s} | / PCA: projection, best in span, default | best below PCA"]
+    for r in rows:
+        pca = r["pca_coords"]
+        lines.append(f"{r['collection']:10s} {r['n_meshes']:6d} {pca:10.2e} {r['feature_projection']:10.2e}"
+                     f" {r['vertex_optimal']:12.2e} {r['default']:9.2e} | {r['feature_projection'] / pca:10.2f}"
+                     f" {r['vertex_optimal'] / pca:6.2f} {r['default'] / pca:6.2f}"
+                     f" | {r['vertex_optimal_below_pca']} of {r['n_meshes']}")
     return "\n".join(lines)
