@@ -26,7 +26,8 @@ from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference.base import InferenceStrategy
 from meshvae_lib.validation import check_count
 
-__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes"]
+__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes",
+           "marquardt_fit", "MarquardtFit"]
 
 
 def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -188,9 +189,88 @@ class _DecodedState:
             self.sq_error = self.mean_error = np.inf              # never accepted
 
 
+class MarquardtFit:
+    """What :func:`marquardt_fit` found.
+
+    Attributes
+    ----------
+    u : (p,) float64
+        The parameters at the end (the start when no step lowered the error).
+    state, start : the objects ``state_at`` returned for ``u`` and for the starting parameters.
+    jacobians : int
+        Jacobians computed (accepted or not).
+    decodes : int
+        Calls of ``state_at``, the starting one included.
+    """
+
+    def __init__(self, u: np.ndarray, state, start, jacobians: int, decodes: int):
+        self.u, self.state, self.start, self.jacobians, self.decodes = u, state, start, jacobians, decodes
+
+
+def marquardt_fit(u0: np.ndarray, state_at, jacobian_at, iterations: int) -> MarquardtFit:
+    """Damped Gauss-Newton (Levenberg-Marquardt with Marquardt's scaling) on a squared vertex error.
+
+    Each step solves ``(J^T J + lambda diag(J^T J)) delta = J^T r`` (the diagonal floored at
+    ``GN_DIAG_FLOOR_RTOL`` of its mean) and is taken only if it lowers the error; a rejected step is
+    retried with ``GN_DAMPING_UP`` times the damping (``GN_MAX_TRIES`` tries), an accepted one lowers
+    it by ``GN_DAMPING_DOWN`` (floor ``GN_DAMPING_FLOOR``). Stops after ``iterations`` Jacobians, when no
+    try lowers the error, when the error falls by less than ``GN_REL_DECREASE``, or where the mesh
+    does not move with the parameters (a zero or non-finite ``J^T J``). Docs: docs/vae.md, "The method".
+
+    Parameters
+    ----------
+    u0 : (p,) float
+        Starting parameters (the used latent dimensions of a code, or coordinates in a feature span).
+    state_at : callable ``u -> state``
+        Decodes ``u``; the state has ``residual`` ((n, 3) float64: the target aligned rigidly onto the
+        decoded mesh, minus the mesh) and ``sq_error`` (float, its squared norm; ``inf`` is never accepted).
+    jacobian_at : callable ``state -> (3 n, p) float64``
+        ``d positions / d u`` at a state, with the rigid motions' fields projected out.
+    iterations : int >= 0
+        Jacobians at most.
+
+    Returns
+    -------
+    MarquardtFit
+    """
+    u = np.array(u0, dtype=np.float64)
+    state = start = state_at(u)
+    jacobians, decodes = 0, 1
+    damping = tol.GN_DAMPING_START
+    for _ in range(int(iterations)):
+        jacobians += 1
+        J = jacobian_at(state)
+        H = J.T @ J
+        g = J.T @ state.residual.ravel()
+        mean_diag = float(np.trace(H)) / len(u)
+        if not (mean_diag > 0 and np.isfinite(H).all() and np.isfinite(g).all()):
+            break     # the decoded mesh does not move with the parameters here (a saturated output)
+        # Marquardt's scaling: each direction damped in proportion to its own curvature, so the
+        # directions that barely move the vertices are not frozen by the large ones
+        scale = np.maximum(np.diag(H), tol.GN_DIAG_FLOOR_RTOL * mean_diag)
+        accepted = None
+        for _ in range(tol.GN_MAX_TRIES):
+            u_new = u + np.linalg.solve(H + damping * np.diag(scale), g)
+            trial = state_at(u_new)
+            decodes += 1
+            if trial.sq_error < state.sq_error:
+                accepted = (u_new, trial)
+                damping = max(damping * tol.GN_DAMPING_DOWN, tol.GN_DAMPING_FLOOR)
+                break
+            damping *= tol.GN_DAMPING_UP
+        if accepted is None:
+            break
+        decrease = 1.0 - accepted[1].sq_error / state.sq_error
+        u, state = accepted
+        if decrease < tol.GN_REL_DECREASE:
+            break
+    return MarquardtFit(u, state, start, jacobians, decodes)
+
+
 def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: np.ndarray | None = None,
                        iterations: int = GAUSS_NEWTON_ITERATIONS, progress: bool = False) -> tuple[np.ndarray, GaussNewtonReport]:
-    """Codes fitted to vertex positions by damped Gauss-Newton with the analytic Jacobian.
+    """Codes fitted to vertex positions by damped Gauss-Newton with the analytic Jacobian
+    (:func:`marquardt_fit` over the latent dimensions the decoder uses).
 
     Parameters
     ----------
@@ -222,44 +302,25 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     used = decoder.used
     if not len(used):                                  # the decoder ignores the code: nothing to fit
         iterations = 0
+
+    def jacobian_at(state: _DecodedState) -> np.ndarray:
+        J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(-1, len(used))
+        Q = rigid_fields(state.lin.positions)
+        return J - Q @ (Q.T @ J)
+
     meshes = progress_bar(range(len(V)), desc="fitting codes", unit="mesh", disable=not progress)
     for j in meshes:
         c = None if conditions is None else conditions[j]
-        state = decoder.state(Z[j], c, V[j])
-        report.initial_error[j], report.decodes[j] = state.mean_error, 1
-        damping = tol.GN_DAMPING_START
-        for _ in range(int(iterations)):
-            report.iterations[j] += 1
-            n = state.residual.shape[0]
-            J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(3 * n, len(used))
-            Q = rigid_fields(state.lin.positions)
-            J = J - Q @ (Q.T @ J)
-            H = J.T @ J
-            g = J.T @ state.residual.ravel()
-            mean_diag = float(np.trace(H)) / len(used)
-            if not (mean_diag > 0 and np.isfinite(H).all() and np.isfinite(g).all()):
-                break     # the decoded mesh does not move with the code here (a saturated output)
-            # Marquardt's scaling: each direction damped in proportion to its own curvature, so the
-            # latent directions that barely move the vertices are not frozen by the large ones
-            scale = np.maximum(np.diag(H), tol.GN_DIAG_FLOOR_RTOL * mean_diag)
-            accepted = None
-            for _ in range(tol.GN_MAX_TRIES):
-                z_new = Z[j].copy()
-                z_new[used] += np.linalg.solve(H + damping * np.diag(scale), g)
-                trial = decoder.state(z_new, c, V[j])
-                report.decodes[j] += 1
-                if trial.sq_error < state.sq_error:
-                    accepted = (z_new, trial)
-                    damping = max(damping * tol.GN_DAMPING_DOWN, tol.GN_DAMPING_FLOOR)
-                    break
-                damping *= tol.GN_DAMPING_UP
-            if accepted is None:
-                break
-            decrease = 1.0 - accepted[1].sq_error / state.sq_error
-            Z[j], state = accepted
-            if decrease < tol.GN_REL_DECREASE:
-                break
-        report.final_error[j] = state.mean_error
+
+        def state_at(u: np.ndarray, z=Z[j].copy(), c=c, x=V[j]) -> _DecodedState:
+            z = z.copy()
+            z[used] = u
+            return decoder.state(z, c, x)
+
+        fit = marquardt_fit(Z[j][used], state_at, jacobian_at, iterations)
+        Z[j][used] = fit.u
+        report.initial_error[j], report.final_error[j] = fit.start.mean_error, fit.state.mean_error
+        report.iterations[j], report.decodes[j] = fit.jacobians, fit.decodes
     return Z, report
 
 
