@@ -11,8 +11,9 @@ with linear PCA on coordinates on the same held-out meshes:
   span of the training features, then reconstructed (what a perfect feature-space encoder gives);
 - ``vertex-optimal in span``: the point of that affine span whose reconstruction is closest to the
   held-out vertices, found by damped Gauss-Newton on the vertex error from the projection, with the
-  analytic Jacobian of the reconstruction (``RIMDReconstructor.linearize``) and ``--iterations``
-  steps; no network, no tanh: the ceiling of any decoder whose image is that span;
+  analytic Jacobian of the reconstruction (``RIMDReconstructor.linearize``), the default inference's
+  own Levenberg-Marquardt (``gauss_newton.marquardt_fit``) and ``--iterations`` steps; no network, no
+  tanh: the ceiling of any decoder whose image is that span;
 - ``default model``: the library's default model trained on the same split and its default inference
   (encoder, then Gauss-Newton on the vertices).
 
@@ -39,40 +40,32 @@ from meshvae_lib import tolerances as tol
 from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.model.evaluation import pca_baseline
 from meshvae_lib.model.feature_kinds import make_kind
-from meshvae_lib.model.inference.gauss_newton import rigid_fields
+from meshvae_lib.model.inference.gauss_newton import marquardt_fit, rigid_fields
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import holdout_mask
 
 
-def _fit_in_span(kind, x: np.ndarray, mean: np.ndarray, B: np.ndarray, z: np.ndarray, iterations: int):
-    """Damped Gauss-Newton over ``f = mean + B z`` on the vertex error to ``x``, the library's
-    Marquardt schedule (``tolerances.GN_*``). Returns the final mean vertex error."""
-    def state(z):
-        lin = kind.linearize(mean + B @ z)
-        P = lin.positions
-        r = rigid_align(x, P) - P
-        return lin, P, r, float(np.einsum("ij,ij->", r, r))
+class _SpanState:
+    """The reconstruction of ``mean + B u`` and its residual to the target (what ``marquardt_fit`` reads)."""
 
-    lin, P, r, E = state(z)
-    damping = tol.GN_DAMPING_START
-    for _ in range(iterations):
-        J = lin.jvp(B).reshape(-1, B.shape[1])
-        Q = rigid_fields(P)
-        J = J - Q @ (Q.T @ J)
-        H, g = J.T @ J, J.T @ r.ravel()
-        scale = np.maximum(np.diag(H), tol.GN_DIAG_FLOOR_RTOL * np.trace(H) / len(H))
-        for _ in range(tol.GN_MAX_TRIES):
-            z_new = z + np.linalg.solve(H + damping * np.diag(scale), g)
-            trial = state(z_new)
-            if trial[3] < E:
-                z, (lin, P, r, E) = z_new, trial
-                damping = max(damping * tol.GN_DAMPING_DOWN, tol.GN_DAMPING_FLOOR)
-                break
-            damping *= tol.GN_DAMPING_UP
-        else:
-            break
-    return float(np.linalg.norm(r, axis=1).mean())
+    def __init__(self, kind, x: np.ndarray, f: np.ndarray):
+        self.lin = kind.linearize(f)
+        P = self.lin.positions
+        self.residual = rigid_align(x, P) - P
+        self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
+        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
+
+
+def _fit_in_span(kind, x: np.ndarray, mean: np.ndarray, B: np.ndarray, z: np.ndarray, iterations: int) -> float:
+    """The library's damped Gauss-Newton (``marquardt_fit``) over ``f = mean + B z`` on the vertex
+    error to ``x``. Returns the final mean vertex error."""
+    def jacobian_at(state):
+        J = state.lin.jvp(B).reshape(-1, B.shape[1])
+        Q = rigid_fields(state.lin.positions)
+        return J - Q @ (Q.T @ J)
+
+    return marquardt_fit(z, lambda u: _SpanState(kind, x, mean + B @ u), jacobian_at, iterations).state.mean_error
 
 
 def main() -> None:
