@@ -291,3 +291,50 @@ def test_a_code_where_the_decoder_saturates_ends_the_fit_instead_of_failing(arcs
         saturated.network_.decoder_head.weight.zero_()
     z, report = gauss_newton_codes(saturated, V, z0, iterations=3)
     np.testing.assert_array_equal(z, z0)
+
+
+class _LinearState:
+    """``P(u) = A u`` against a fixed target ``y``: the state marquardt_fit reads."""
+
+    def __init__(self, A, y, u):
+        self.positions = (A @ u).reshape(-1, 3)
+        self.residual = y.reshape(-1, 3) - self.positions
+        self.sq_error = float(np.sum(self.residual ** 2))
+        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
+
+
+def test_marquardt_fit_solves_a_linear_least_squares_problem():
+    """On a linear P(u) = A u the damped steps converge to the least-squares solution (numpy's lstsq),
+    whatever the scale of A's columns (Marquardt's scaling), and never raise the error."""
+    from meshvae_lib.model.inference.gauss_newton import marquardt_fit
+
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(60, 5)) * np.array([1.0, 1e-3, 10.0, 0.1, 1e2])
+    y = A @ rng.normal(size=5) + 0.01 * rng.normal(size=60)   # not in A's range: a non-zero optimum
+    u_star = np.linalg.lstsq(A, y, rcond=None)[0]
+    fit = marquardt_fit(np.zeros(5), lambda u: _LinearState(A, y, u), lambda s: A, iterations=10)
+    assert np.allclose(fit.u, u_star, rtol=1e-5, atol=1e-8 * np.abs(u_star).max())
+    assert fit.state.sq_error <= fit.start.sq_error
+    assert fit.start.sq_error == pytest.approx(float(y @ y))
+    assert 1 <= fit.jacobians <= 10 and fit.decodes >= fit.jacobians + 1
+
+
+def test_marquardt_fit_stops_where_the_mesh_does_not_move_or_no_step_helps():
+    from meshvae_lib import tolerances as tol
+    from meshvae_lib.model.inference.gauss_newton import marquardt_fit
+
+    A, y = np.ones((6, 2)), np.arange(6.0)
+    # a zero Jacobian: one Jacobian computed, no step tried, the start returned
+    fit = marquardt_fit(np.array([0.5, -1.0]), lambda u: _LinearState(A, y, u), lambda s: np.zeros((6, 2)), 4)
+    assert (fit.jacobians, fit.decodes) == (1, 1) and np.array_equal(fit.u, [0.5, -1.0])
+
+    # every trial decodes to an infinite error: GN_MAX_TRIES rejected tries, then the start
+    def state_at(u):
+        s = _LinearState(A, y, u)
+        if np.any(u != 0):
+            s.sq_error = np.inf
+        return s
+
+    fit = marquardt_fit(np.zeros(2), state_at, lambda s: A, 4)
+    assert (fit.jacobians, fit.decodes) == (1, 1 + tol.GN_MAX_TRIES)
+    assert np.array_equal(fit.u, [0.0, 0.0]) and fit.state is fit.start
