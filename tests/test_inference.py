@@ -338,3 +338,9 @@ def test_marquardt_fit_stops_where_the_mesh_does_not_move_or_no_step_helps():
     fit = marquardt_fit(np.zeros(2), state_at, lambda s: A, 4)
     assert (fit.jacobians, fit.decodes) == (1, 1 + tol.GN_MAX_TRIES)
     assert np.array_equal(fit.u, [0.0, 0.0]) and fit.state is fit.start
+
+    # no parameters: nothing to fit, whatever the iterations; a negative count is refused
+    fit = marquardt_fit(np.zeros(0), lambda u: _LinearState(np.zeros((6, 0)), y, u), lambda s: np.zeros((6, 0)), 4)
+    assert (fit.jacobians, fit.decodes) == (0, 1)
+    with pytest.raises(ValueError, match="iterations"):
+        marquardt_fit(np.zeros(2), lambda u: _LinearState(A, y, u), lambda s: A, -1)

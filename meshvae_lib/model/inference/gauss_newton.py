@@ -227,17 +227,18 @@ def marquardt_fit(u0: np.ndarray, state_at, jacobian_at, iterations: int) -> Mar
     jacobian_at : callable ``state -> (3 n, p) float64``
         ``d positions / d u`` at a state, with the rigid motions' fields projected out.
     iterations : int >= 0
-        Jacobians at most.
+        Jacobians at most (none when ``u0`` is empty).
 
     Returns
     -------
     MarquardtFit
     """
-    u = np.array(u0, dtype=np.float64)
+    u = np.array(u0, dtype=np.float64).reshape(-1)
+    iterations = check_count(iterations, "iterations", minimum=0) if len(u) else 0   # nothing to fit: no Jacobian
     state = start = state_at(u)
     jacobians, decodes = 0, 1
     damping = tol.GN_DAMPING_START
-    for _ in range(int(iterations)):
+    for _ in range(iterations):
         jacobians += 1
         J = jacobian_at(state)
         H = J.T @ J
@@ -299,9 +300,7 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     Z = np.array(z0, dtype=np.float64)
     report = GaussNewtonReport(len(V))
     decoder = _Decoder(model, conditions)
-    used = decoder.used
-    if not len(used):                                  # the decoder ignores the code: nothing to fit
-        iterations = 0
+    used = decoder.used                    # none: the decoder ignores the code, nothing to fit
 
     def jacobian_at(state: _DecodedState) -> np.ndarray:
         J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(-1, len(used))
