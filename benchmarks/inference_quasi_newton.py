@@ -26,16 +26,9 @@ import torch
 
 from feature_comparison import load_real
 from meshvae_lib import tolerances as tol
-from meshvae_lib.model.inference.gauss_newton import _Decoder, gauss_newton_codes, rigid_fields
+from meshvae_lib.model.inference.gauss_newton import _Decoder, gauss_newton_codes
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
-
-
-def _jacobian(decoder, state) -> np.ndarray:
-    n = state.residual.shape[0]
-    J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(3 * n, len(decoder.used))
-    Q = rigid_fields(state.lin.positions)
-    return J - Q @ (Q.T @ J)
 
 
 def _gradient(decoder, state) -> np.ndarray:
@@ -98,7 +91,7 @@ def main() -> None:
     mu_t, _ = model.encode_rows(model.features_of(Vt), None)
     t0 = time.perf_counter()
     picks = np.linspace(0, len(Vt) - 1, args.metric_meshes).round().astype(int)
-    H0 = np.mean([(lambda J: J.T @ J)(_jacobian(decoder, decoder.state(mu_t[i], None, Vt[i]))) for i in picks], axis=0)
+    H0 = np.mean([(lambda J: J.T @ J)(decoder.vertex_jacobian(decoder.state(mu_t[i], None, Vt[i]))) for i in picks], axis=0)
     print(f"{len(decoder.used)} used dimensions; metric from {len(picks)} training meshes in {time.perf_counter() - t0:.1f} s")
     mu, _ = model.encode_rows(model.features_of(Vh), None)
     t0 = time.perf_counter()

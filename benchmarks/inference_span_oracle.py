@@ -37,35 +37,21 @@ import torch
 
 from feature_comparison import REAL_CITATIONS, load_real
 from meshvae_lib import tolerances as tol
-from meshvae_lib.geometry.alignment import rigid_align
-from meshvae_lib.model.evaluation import pca_baseline
+from meshvae_lib.model.evaluation import pca_baseline, per_vertex_error
 from meshvae_lib.model.feature_kinds import make_kind
-from meshvae_lib.model.inference.gauss_newton import marquardt_fit, rigid_fields
+from meshvae_lib.model.inference.gauss_newton import FitState, marquardt_fit, without_rigid_motions
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import holdout_mask
 
 
-class _SpanState:
-    """The reconstruction of ``mean + B u`` and its residual to the target (what ``marquardt_fit`` reads)."""
-
-    def __init__(self, kind, x: np.ndarray, f: np.ndarray):
-        self.lin = kind.linearize(f)
-        P = self.lin.positions
-        self.residual = rigid_align(x, P) - P
-        self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
-        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
-
-
 def _fit_in_span(kind, x: np.ndarray, mean: np.ndarray, B: np.ndarray, z: np.ndarray, iterations: int) -> float:
     """The library's damped Gauss-Newton (``marquardt_fit``) over ``f = mean + B z`` on the vertex
     error to ``x``. Returns the final mean vertex error."""
-    def jacobian_at(state):
-        J = state.lin.jvp(B).reshape(-1, B.shape[1])
-        Q = rigid_fields(state.lin.positions)
-        return J - Q @ (Q.T @ J)
+    def jacobian_at(state: FitState) -> np.ndarray:
+        return without_rigid_motions(state.lin.jvp(B).reshape(-1, B.shape[1]), state.lin.positions)
 
-    return marquardt_fit(z, lambda u: _SpanState(kind, x, mean + B @ u), jacobian_at, iterations).state.mean_error
+    return marquardt_fit(z, lambda u: FitState(kind.linearize(mean + B @ u), x), jacobian_at, iterations).state.mean_error
 
 
 def main() -> None:
@@ -102,8 +88,7 @@ def main() -> None:
     proj, span, t_span = [], [], []
     for x, f in zip(Vh, Fh):
         z = B.T @ (f - mean)
-        P = kind.decode((mean + B @ z)[None])[0]
-        proj.append(float(np.linalg.norm(rigid_align(x, P) - P, axis=1).mean()))
+        proj.append(per_vertex_error(kind.decode((mean + B @ z)[None])[0], x))
         t0 = time.perf_counter()
         span.append(_fit_in_span(kind, x, mean, B, z, args.iterations))
         t_span.append(time.perf_counter() - t0)

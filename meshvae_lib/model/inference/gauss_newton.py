@@ -26,8 +26,8 @@ from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference.base import InferenceStrategy
 from meshvae_lib.validation import check_count
 
-__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "GaussNewtonReport", "gauss_newton_codes",
-           "marquardt_fit", "MarquardtFit"]
+__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "without_rigid_motions", "GaussNewtonReport",
+           "gauss_newton_codes", "marquardt_fit", "MarquardtFit", "FitState"]
 
 
 def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,6 +106,14 @@ def rigid_fields(P: np.ndarray) -> np.ndarray:
     return Q
 
 
+def without_rigid_motions(J: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Columns of a vertex Jacobian ``J (3 n_vertices, p)`` with the rigid motions' fields at the mesh
+    ``P (n_vertices, 3)`` (:func:`rigid_fields`) projected out: what the fit's rigid alignment of the
+    target cannot tell from a move of the mesh. Returns (3 n_vertices, p) float64."""
+    Q = rigid_fields(P)
+    return J - Q @ (Q.T @ J)
+
+
 class GaussNewtonReport:
     """What :func:`gauss_newton_codes` did, per mesh.
 
@@ -173,20 +181,46 @@ class _Decoder:
             return self.scale[:, None] * state.network_jacobian[:, self.used]
         return (self.scale * state.slope)[:, None] * self.W
 
+    def vertex_jacobian(self, state: "_DecodedState") -> np.ndarray:
+        """d positions / d z[used] at a decoded state, rigid motions projected out: (3 n, n_used) float64."""
+        J = state.lin.jvp(self.feature_jacobian(state)).reshape(-1, len(self.used))
+        return without_rigid_motions(J, state.lin.positions)
 
-class _DecodedState:
-    """A decoded code: positions before alignment, the residual to the target, the linearisation."""
+
+class FitState:
+    """A decoded mesh against the mesh it should match: what :func:`marquardt_fit` reads.
+
+    Parameters
+    ----------
+    lin : the decoding's linearisation (``FeatureKind.linearize``): ``positions (n, 3)``, ``jvp``, ``vjp``.
+    x : (n, 3) float64, the target mesh (any rigid pose).
+
+    Attributes
+    ----------
+    residual : (n, 3) float64
+        The target moved rigidly onto the decoded positions, minus them.
+    sq_error, mean_error : float
+        Its squared norm and mean vertex distance; ``inf`` when not finite (never accepted).
+    """
+
+    def __init__(self, lin, x: np.ndarray):
+        self.lin = lin
+        P = lin.positions
+        self.residual = rigid_align(x, P) - P
+        self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
+        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
+        if not np.isfinite(self.sq_error):
+            self.sq_error = self.mean_error = np.inf
+
+
+class _DecodedState(FitState):
+    """A decoded code: :class:`FitState` plus what the network's Jacobian needs (the output's slope,
+    or with internal layers the network Jacobian computed with the rows)."""
 
     def __init__(self, decoder: _Decoder, features: np.ndarray, slope, x: np.ndarray):
         self.slope = slope
         self.network_jacobian = getattr(decoder, "_J", None)
-        self.lin = decoder.kind.linearize(features)
-        P = self.lin.positions
-        self.residual = rigid_align(x, P) - P                      # (n, 3): target moved onto P
-        self.sq_error = float(np.einsum("ij,ij->", self.residual, self.residual))
-        self.mean_error = float(np.linalg.norm(self.residual, axis=1).mean())
-        if not np.isfinite(self.sq_error):
-            self.sq_error = self.mean_error = np.inf              # never accepted
+        super().__init__(decoder.kind.linearize(features), x)
 
 
 class MarquardtFit:
@@ -223,9 +257,11 @@ def marquardt_fit(u0: np.ndarray, state_at, jacobian_at, iterations: int) -> Mar
         Starting parameters (the used latent dimensions of a code, or coordinates in a feature span).
     state_at : callable ``u -> state``
         Decodes ``u``; the state has ``residual`` ((n, 3) float64: the target aligned rigidly onto the
-        decoded mesh, minus the mesh) and ``sq_error`` (float, its squared norm; ``inf`` is never accepted).
+        decoded mesh, minus the mesh) and ``sq_error`` (float, its squared norm; ``inf`` is never
+        accepted), as a :class:`FitState` has.
     jacobian_at : callable ``state -> (3 n, p) float64``
-        ``d positions / d u`` at a state, with the rigid motions' fields projected out.
+        ``d positions / d u`` at a state, with the rigid motions' fields projected out
+        (:func:`without_rigid_motions`).
     iterations : int >= 0
         Jacobians at most (none when ``u0`` is empty).
 
@@ -301,22 +337,17 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     report = GaussNewtonReport(len(V))
     decoder = _Decoder(model, conditions)
     used = decoder.used                    # none: the decoder ignores the code, nothing to fit
-
-    def jacobian_at(state: _DecodedState) -> np.ndarray:
-        J = state.lin.jvp(decoder.feature_jacobian(state)).reshape(-1, len(used))
-        Q = rigid_fields(state.lin.positions)
-        return J - Q @ (Q.T @ J)
-
     meshes = progress_bar(range(len(V)), desc="fitting codes", unit="mesh", disable=not progress)
     for j in meshes:
         c = None if conditions is None else conditions[j]
+        start = Z[j].copy()
 
-        def state_at(u: np.ndarray, z=Z[j].copy(), c=c, x=V[j]) -> _DecodedState:
-            z = z.copy()
+        def state_at(u: np.ndarray) -> _DecodedState:   # called within this iteration only
+            z = start.copy()
             z[used] = u
-            return decoder.state(z, c, x)
+            return decoder.state(z, c, V[j])
 
-        fit = marquardt_fit(Z[j][used], state_at, jacobian_at, iterations)
+        fit = marquardt_fit(start[used], state_at, decoder.vertex_jacobian, iterations)
         Z[j][used] = fit.u
         report.initial_error[j], report.final_error[j] = fit.start.mean_error, fit.state.mean_error
         report.iterations[j], report.decodes[j] = fit.jacobians, fit.decodes
