@@ -79,3 +79,56 @@ def test_span_ceiling_table_prints_the_recorded_errors_and_their_ratios_to_pca()
                                 "|", "9", "of", "40"]
     assert lines[2].split() == ["b/3", "12", "2.00e-02", "7.00e-02", "1.50e-02", "1.40e-02", "|", "3.50", "0.75", "0.70",
                                 "|", "10", "of", "12"]
+
+
+
+def _strips(n=12, seed=0):
+    """A strip of 6 x 3 vertices bent by a random amount: a tiny collection to fit models on."""
+    from meshvae_lib.geometry.collection import MeshCollection
+
+    rng = np.random.default_rng(seed)
+    nx, ny = 6, 3
+    F = [[i * ny + j, (i + 1) * ny + j, i * ny + j + 1] for i in range(nx - 1) for j in range(ny - 1)]
+    F += [[(i + 1) * ny + j, (i + 1) * ny + j + 1, i * ny + j + 1] for i in range(nx - 1) for j in range(ny - 1)]
+    V0 = np.array([[i, j, 0.0] for i in range(nx) for j in range(ny)])
+    Vs = [V0 + np.c_[np.zeros((len(V0), 2)), rng.uniform(0.2, 1.0) * np.sin(V0[:, :1])] for _ in range(n)]
+    return MeshCollection(np.array(Vs), np.array(F))
+
+
+def test_model_summary_says_the_start_the_epochs_and_what_training_changed():
+    from meshvae_lib.course.display import describe_model, model_summary
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.model.train_config import TrainConfig
+
+    coll = _strips()
+    start = MeshVAEModel("coords", TrainConfig(epochs=5, early_stopping=False, progress=False)).fit(coll)
+    d = describe_model(start)
+    assert (d["start"], d["hidden"], d["epochs"], d["epoch_budget"], d["early_stopping"]) == ("PCA", (), 5, 5, False)
+    assert d["features"] == "coords" and d["n_features"] == 54 and d["used_dims"] <= d["latent_dim"]
+    assert len(start.history_) == 5 and d["mse_first"] == start.history_[0]["mse"] and d["mse_last"] == start.history_[-1]["mse"]
+    text = model_summary(start)
+    assert "the PCA of the training features" in text and "5 of 5 epochs (a fixed budget)" in text
+    assert "no internal layer" in text and "K = 54" in text
+
+    rand = MeshVAEModel("coords", TrainConfig(epochs=3, init="random", hidden=(8,), latent_dim=2,
+                                               early_stopping=False, progress=False)).fit(coll)
+    d = describe_model(rand)
+    assert (d["start"], d["hidden"], d["latent_dim"]) == ("random", (8,), 2)
+    assert "internal layers 8" in model_summary(rand) and "random weights" in model_summary(rand)
+
+    chosen = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=4).fit(_strips(40))
+    d = describe_model(chosen)
+    assert d["early_stopping"] and d["epochs"] == len(chosen.history_) - (d["epochs"] == 0) == chosen.train_epochs_
+    if d["epochs"] == 0:
+        assert d["mse_first"] == d["mse_last"] and "(chosen by early stopping): the model is its start" in model_summary(chosen)
+    else:
+        assert f"{d['epochs']} of 1000 epochs (chosen by early stopping)" in model_summary(chosen)
+
+
+def test_model_summary_refuses_an_unfitted_model():
+    from meshvae_lib.course.display import model_summary
+    from meshvae_lib.model.meshvae_model import MeshVAEModel
+    from meshvae_lib.validation import NotFittedError
+
+    with pytest.raises(NotFittedError):
+        model_summary(MeshVAEModel())

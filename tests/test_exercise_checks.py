@@ -10,6 +10,7 @@ from the cache, as for nbval), and every self-check must raise on every one of t
 
 from __future__ import annotations
 
+import runpy
 from pathlib import Path
 
 import nbformat
@@ -21,128 +22,12 @@ from meshvae_lib.course.notebooks import (TRIVIAL_ANSWERS, solution_names, trivi
 NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
 
-#: (notebook stem, exercise number from 1) -> {name: code run in place of the solution}: one-line
-#: wrong answers that self-checks accepted, each of which its self-check must now reject.
-WRONG_ANSWERS = {
-    ("01_deformation_gradients", 1): {
-        "the mesh is never rotated": (
-            "Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n"
-            "T_before = op(V1)\n"
-            "T_after = Q @ T_before\n"
-            "rigid_err = 0.0\n"),
-        "the mesh is moved but not measured": (
-            "Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n"
-            "V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n"
-            "T_before = op(V1)\n"
-            "T_after = Q @ T_before\n"
-            "rigid_err = 0.0\n"),
-    },
-    ("01_deformation_gradients", 2): {
-        "library weights typed in from the printout": (
-            "c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n"
-            "P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n"
-            "P_sq = np.array([[0.0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 0, 0]])\n"
-            "pair = np.array([[0, 1, 2], [1, 0, 3]])\n"
-            "lib_eq, lib_sq = 1.1547, 0.0\n"),
-        "the square is never built": (
-            "c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n"
-            "P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n"
-            "P_sq = P_eq.copy()\n"
-            "pair = np.array([[0, 1, 2], [1, 0, 3]])\n"
-            "lib_eq = float(cotangent_weights(P_eq, pair, clamp=False)[edge_index(edges(pair), 0, 1)])\n"
-            "lib_sq = 0.0\n"),
-    },
-    ("02_rimd", 2): {
-        "V_lin is the feature midpoint": (
-            "Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n"
-            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
-            "V_lin = V_mid.copy()\n"
-            "L0 = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1)\n"
-            "stretch_mid = stretch_lin = float(np.mean(np.abs(np.linalg.norm(V_mid[E[:, 0]] - V_mid[E[:, 1]], axis=1) / L0 - 1)))\n"),
-        "the two poses of the first attempt": (
-            "Va, Vb = col.vertices[poses[0]], col.vertices[poses[2]]\n"
-            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
-            "V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n"
-            "L0 = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1)\n"
-            "stretch_mid, stretch_lin = (float(np.mean(np.abs(np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1) / L0 - 1)))"
-            " for X in (V_mid, V_lin))\n"),
-        "stretch as the vertex average": (
-            "Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n"
-            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
-            "V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n"
-            "stretch_mid, stretch_lin = (float(vertex_edge_stretch(X, V0, F).mean()) for X in (V_mid, V_lin))\n"),
-    },
-    ("03_normalization", 2): {
-        "margin typed in from the text": (
-            "f_top = norm.inverse_transform(np.ones((1, X.shape[1])))[0]\n"
-            "margin = 1 / 18\n"),
-        "f_top is the training maximum": (
-            "f_top = X.max(axis=0)\n"
-            "margin = np.full(X.shape[1], 1 / 18)\n"),
-    },
-    ("04_training", 1): {
-        "zero tensors with sigma = 1": (
-            "x = x_hat = mu = torch.zeros(8, 4)\n"
-            "sigma = torch.ones(8, 4)\n"
-            "rec_term = kl_term = 0.0\n"),
-    },
-    ("04_training", 3): {
-        "a threshold typed in from the text": "alpha_off = np.full(LATENT, 1e3)\n",
-        "sigma = 1/sqrt(2) instead of 0.5 (K / c^2)": (
-            "c_paper = decoder_column_norms(model.network, model.encode_meshes(train_V, inference='encoder')).mean(axis=0)\n"
-            "alpha_off = model.n_features / c_paper ** 2\n"),
-        "column norms at the held-out meshes": (
-            "c_paper = decoder_column_norms(model.network, model.encode_meshes(col.vertices[held_out], inference='encoder')).mean(axis=0)\n"
-            "alpha_off = 3 * model.n_features / c_paper ** 2\n"),
-    },
-    ("07_sigma_object_embeddings", 1): {
-        "the check's own expression": "gap = exact - sibling\n",
-        "the total split evenly": "gap = torch.full((3,), (exact - sibling) / 3)\n",
-    },
-    ("07_sigma_object_embeddings", 2): {
-        "only pair (1, 2) right": (
-            "pair_auc = np.r_[curves['σ_object VAE (ours)'].auc['mean'], np.full(LATENT // 2 - 1, 0.5)]\n"),
-        "overlapping pairs (1, 2), (2, 3), ...": (
-            "pair_auc = np.array([ret.retrieval_auc(Z[median_seed][:, i:i + 2], labels) for i in range(LATENT // 2)])\n"),
-    },
-    ("08_exploration", 1): {
-        "strength [1, 1, 1, 1, 0, ...]": "strength = np.r_[np.ones(4), np.zeros(LATENT - 4)]\n",
-        "only the four dimensions of section 4 swept": (
-            "strength = np.r_[np.abs(effects.effect).max(axis=1), np.zeros(LATENT - 4)]\n"),
-    },
-    ("09_evaluation", 1): {
-        "the floor copied from the table": (
-            "pca_err = rows['jumping']['ours aligned']\n"
-            "rimd_over_pca = rows['jumping']['ours rimd'] / pca_err\n"),
-        "a floor of zero": "pca_err = 0.0\nrimd_over_pca = float('inf')\n",
-    },
-    ("09_evaluation", 3): {
-        "the threshold applied to the learned errors": (
-            "floor_rel = {name: rows[name]['ours rimd'] for name in rows}\n"
-            "informative = [name for name in rows if floor_rel[name] >= 1e-4]\n"),
-        "absolute floors, not relative to the diagonal": (
-            "floor_rel = {}\n"
-            "for name in rows:\n"
-            "    coll = paper.load_collection(name, full.settings)\n"
-            "    held = holdout_mask(len(coll.vertices), full.settings.holdout_every)\n"
-            "    floor_rel[name] = float(pca_baseline(coll.vertices[~held], coll.vertices[held])['mean_vertex_error'])\n"
-            "informative = [name for name in rows if floor_rel[name] >= 1e-4]\n"),
-    },
-    ("10_bring_your_own", 1): {
-        "any three meshes of the data": (
-            "column = next(iter(coll.labels))\n"
-            "value = sorted(set(coll.labels[column]))[0]\n"
-            "cond = MeshVAEModel('rimd', config, labels=(column,), layout='compact').fit(coll)\n"
-            "cond_meshes = coll.vertices[:3]\n"),
-    },
-    ("10_bring_your_own", 2): {
-        "err_shuffled = 1.0": (
-            "rng = np.random.default_rng(SEED)\n"
-            "Vs = coll.vertices[1][rng.permutation(coll.n_vertices)]\n"
-            "shuffled = collection.MeshCollection(Vs[None], coll.faces, ['shuffled'], {})\n"
-            "err_shuffled = 1.0\n"),
-    },
-}
+#: (notebook stem, exercise number from 1) -> {name: code run in place of the solution}: wrong
+#: answers a student would try, each of which its self-check must reject. One file per notebook in
+#: tests/wrong_answers/ (its WRONG_ANSWERS maps exercise -> {name: code}).
+WRONG_ANSWERS = {(path.stem, exercise): answers
+                 for path in sorted((Path(__file__).resolve().parent / "wrong_answers").glob("[0-9][0-9]_*.py"))
+                 for exercise, answers in runpy.run_path(str(path))["WRONG_ANSWERS"].items()}
 
 
 def wrong_answers_of(stem: str) -> dict[int, dict[str, str]]:
@@ -215,6 +100,14 @@ def test_the_trivial_answer_notebook_tries_named_wrong_answers():
         trivial_answer_notebook(nb, wrong_answers={3: {"x": "pass"}})
     with pytest.raises(ValueError, match="trivial answers' names"):
         trivial_answer_notebook(nb, wrong_answers={1: {"None": "answer = None"}})
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_every_exercise_is_attacked_with_at_least_two_wrong_answers(path):
+    _, exercises = trivial_answer_notebook(nbformat.read(path, as_version=4))
+    wrong = wrong_answers_of(path.stem)
+    thin = {number: len(wrong.get(number, {})) for number in range(1, len(exercises) + 1) if len(wrong.get(number, {})) < 2}
+    assert not thin, f"{path.stem}: exercises with fewer than two wrong answers in tests/wrong_answers/{path.stem}.py: {thin}"
 
 
 def test_every_wrong_answer_names_an_existing_exercise():

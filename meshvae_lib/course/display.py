@@ -11,7 +11,8 @@ import numpy as np
 
 from meshvae_lib.tolerances import TIE_RTOL
 
-__all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table"]
+__all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table",
+           "describe_model", "model_summary"]
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -105,3 +106,61 @@ def span_ceiling_table(rows) -> str:
                      f" {r['vertex_optimal'] / pca:6.2f} {r['default'] / pca:6.2f}"
                      f" | {r['vertex_optimal_below_pca']} of {r['n_meshes']}")
     return "\n".join(lines)
+
+
+def describe_model(model) -> dict:
+    """What a fitted :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` is, as plain values.
+
+    Returns a dict: ``features`` (the feature kind), ``n_features`` (K), ``latent_dim`` (D),
+    ``used_dims`` (dimensions the decoder uses), ``hidden`` (internal layer sizes, outermost first;
+    empty: one linear map each way), ``conditions`` (number of condition inputs), ``sigma_object``
+    (True when a sigma_object prior was trained), ``start`` ("PCA" or "random"), ``epoch_budget``
+    (the configured epochs), ``epochs`` (epochs the network was trained for), ``early_stopping``
+    (True when early stopping chose them), ``mse_first`` and ``mse_last`` (the training
+    reconstruction MSE of the first and the last history record; equal when not trained).
+    """
+    from meshvae_lib.validation import check_is_fitted
+
+    check_is_fitted(model, ("network_", "train_config_", "history_"), "call fit(collection) or load_model(path) first")
+    config = model.train_config_
+    n_cond = int(model.n_conditions)
+    history = model.history_
+    return {
+        "features": str(model.features),
+        "n_features": int(model.n_features),
+        "latent_dim": int(model.latent_dim),
+        "used_dims": int(len(model.used_latent_dims)),
+        "hidden": tuple(int(h) for h in config.hidden),
+        "conditions": n_cond,
+        "sigma_object": config.sigma_object is not None,
+        "start": "PCA" if config.uses_pca_init(n_cond) else "random",
+        "epoch_budget": int(config.epochs),
+        "epochs": int(model.train_epochs_),
+        "early_stopping": model.selection_ is not None,
+        "mse_first": float(history[0]["mse"]),
+        "mse_last": float(history[-1]["mse"]),
+    }
+
+
+def model_summary(model) -> str:
+    """A few lines that say which model a lesson uses: its network, its start, how long it trained
+    and what training changed (see :func:`describe_model`). Training digits differ between
+    machines: print it in a ``# NBVAL_IGNORE_OUTPUT`` cell."""
+    d = describe_model(model)
+    layers = "no internal layer (one linear map each way)" if not d["hidden"] else \
+        "internal layers " + " -> ".join(str(h) for h in d["hidden"])
+    extras = [f"{d['conditions']} condition inputs"] * bool(d["conditions"]) + ["a sigma_object prior"] * d["sigma_object"]
+    start = "the PCA of the training features" if d["start"] == "PCA" else "random weights (PyTorch's initialisation)"
+    chosen = "chosen by early stopping" if d["early_stopping"] else "a fixed budget"
+    if d["epochs"] == 0:
+        trained = f"0 of {d['epoch_budget']} epochs ({chosen}): the model is its start"
+    else:
+        change = d["mse_last"] / d["mse_first"] - 1 if d["mse_first"] > 0 else 0.0
+        trained = (f"{d['epochs']} of {d['epoch_budget']} epochs ({chosen}); training MSE {d['mse_first']:.3g} "
+                   f"after the first epoch, {d['mse_last']:.3g} after the last ({change:+.0%})")
+    return "\n".join([
+        f"features: {d['features']} (K = {d['n_features']}), latent {d['latent_dim']} ({d['used_dims']} used)",
+        f"network:  {layers}" + "".join(", " + e for e in extras),
+        f"start:    {start}",
+        f"training: {trained}",
+    ])

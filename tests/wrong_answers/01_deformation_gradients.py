@@ -1,0 +1,39 @@
+"""Wrong answers to the exercises of notebook 01_deformation_gradients: each must make its self-check raise.
+
+Keys are exercise numbers from 1; values map a short description to the code run in place of
+the solution (tests/test_exercise_checks.py runs them)."""
+
+WRONG_ANSWERS = {
+    1: {
+        'the mesh is never rotated': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'T_before = op(V1)\n'
+            'T_after = Q @ T_before\n'
+            'rigid_err = 0.0\n'
+        ),
+        'the mesh is moved but not measured': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before = op(V1)\n'
+            'T_after = Q @ T_before\n'
+            'rigid_err = 0.0\n'
+        ),
+    },
+    2: {
+        'library weights typed in from the printout': (
+            'c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n'
+            'P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n'
+            'P_sq = np.array([[0.0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 0, 0]])\n'
+            'pair = np.array([[0, 1, 2], [1, 0, 3]])\n'
+            'lib_eq, lib_sq = 1.1547, 0.0\n'
+        ),
+        'the square is never built': (
+            'c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n'
+            'P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n'
+            'P_sq = P_eq.copy()\n'
+            'pair = np.array([[0, 1, 2], [1, 0, 3]])\n'
+            'lib_eq = float(cotangent_weights(P_eq, pair, clamp=False)[edge_index(edges(pair), 0, 1)])\n'
+            'lib_sq = 0.0\n'
+        ),
+    },
+}

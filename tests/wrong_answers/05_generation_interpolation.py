@@ -1,0 +1,7 @@
+"""Wrong answers to the exercises of notebook 05_generation_interpolation: each must make its self-check raise.
+
+Keys are exercise numbers from 1; values map a short description to the code run in place of
+the solution (tests/test_exercise_checks.py runs them)."""
+
+WRONG_ANSWERS = {
+}

@@ -1,0 +1,23 @@
+"""Wrong answers to the exercises of notebook 10_bring_your_own: each must make its self-check raise.
+
+Keys are exercise numbers from 1; values map a short description to the code run in place of
+the solution (tests/test_exercise_checks.py runs them)."""
+
+WRONG_ANSWERS = {
+    1: {
+        'any three meshes of the data': (
+            'column = next(iter(coll.labels))\n'
+            'value = sorted(set(coll.labels[column]))[0]\n'
+            "cond = MeshVAEModel('rimd', config, labels=(column,), layout='compact').fit(coll)\n"
+            'cond_meshes = coll.vertices[:3]\n'
+        ),
+    },
+    2: {
+        'err_shuffled = 1.0': (
+            'rng = np.random.default_rng(SEED)\n'
+            'Vs = coll.vertices[1][rng.permutation(coll.n_vertices)]\n'
+            "shuffled = collection.MeshCollection(Vs[None], coll.faces, ['shuffled'], {})\n"
+            'err_shuffled = 1.0\n'
+        ),
+    },
+}
