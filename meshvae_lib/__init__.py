@@ -1,13 +1,49 @@
 """meshvae_lib: mesh variational autoencoders (Tan, Gao, Lai, Xia, CVPR 2018) in Python.
 
-The library is a set of small modules, one concept each; import what you need::
+The face of the library, for scripts and notebooks::
 
-    from meshvae_lib.geometry.collection_io import read_collection
-    from meshvae_lib.geometry.rimd import rimd_features
-    from meshvae_lib.geometry.reconstruction import RIMDReconstructor
+    import meshvae_lib as mv
 
-Importing the package does no work: heavy dependencies (torch, pythreejs) are imported only by the
-modules that need them.
+    coll = mv.read_collection("my_meshes/")          # a folder of OBJ/PLY/OFF files or an .npz
+    model = mv.MeshVAEModel("rimd").fit(coll)        # the paper's mesh VAE on RIMD features
+    model.save("model.pt"); model = mv.load_model("model.pt", coll)
+
+The same names live in small modules, one concept each (``meshvae_lib.geometry.rimd``,
+``meshvae_lib.model.meshvae_model``, ...); :data:`FACADE` says where. Importing the package does
+no work: each name is imported from its module the first time it is used, so ``import meshvae_lib``
+pulls in neither torch nor pythreejs.
 """
 
+from __future__ import annotations
+
+import importlib
+
 __version__ = "0.1.0"
+
+#: name -> the module that defines it.
+FACADE = {
+    "read_collection": "meshvae_lib.geometry.collection_io",
+    "MeshCollection": "meshvae_lib.geometry.collection",
+    "cotangent_weights": "meshvae_lib.geometry.cotangent",
+    "deformation_gradients": "meshvae_lib.geometry.deformation_gradient",
+    "rimd_features": "meshvae_lib.geometry.rimd",
+    "RIMDReconstructor": "meshvae_lib.geometry.reconstruction",
+    "MeshVAEModel": "meshvae_lib.model.meshvae_model",
+    "load_model": "meshvae_lib.model.meshvae_model",
+    "TrainConfig": "meshvae_lib.model.train_config",
+}
+
+__all__ = ["__version__", *FACADE]
+
+
+def __getattr__(name: str):
+    module = FACADE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'meshvae_lib' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(FACADE))
