@@ -75,7 +75,7 @@ def _cmd_html(args) -> int:
     total = time.perf_counter()
     for path in _notebook_paths(args.notebooks):
         start = time.perf_counter()
-        nb = execute_notebook(path, timeout=args.timeout)
+        nb = execute_notebook(path, timeout=args.timeout, store_widget_state=False)   # offline HTML: PNG snapshots
         body, _ = exporter.from_notebook_node(nb)
         target = out / (path.stem + ".html")
         target.write_text(body, encoding="utf-8")

@@ -127,7 +127,7 @@ def inject_parameters(nb, parameters: dict[str, str]):
 
 
 def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3",
-                     store_widget_state: bool = False, parameters: dict[str, str] | None = None):
+                     store_widget_state: bool | None = None, parameters: dict[str, str] | None = None):
     """Execute a notebook on a fresh kernel, in its own folder, and return it.
 
     Parameters
@@ -138,10 +138,14 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         Seconds allowed per cell.
     kernel_name : str
         The Jupyter kernel to run it on.
-    store_widget_state : bool
+    store_widget_state : bool, optional
         Store the widgets' state in the notebook. Off by default: the 3D views' state holds
         every vertex buffer (megabytes) and an HTML export of it needs the three.js widget code
         from a CDN; without it each view exports as the PNG snapshot the viewer stores beside it.
+        ``None`` (the default) does what the notebook asks in its metadata
+        (``"meshvae": {"store_widget_state": true}``: notebook 00, whose state is small enough to
+        keep), else stores nothing; without state, any state an earlier run left is removed, since
+        it would describe widgets that no output shows any more.
     parameters : dict of str to str, optional
         Overrides of the parameters cell (see :func:`inject_parameters`).
     """
@@ -149,6 +153,10 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
+    if store_widget_state is None:
+        store_widget_state = bool(nb.metadata.get("meshvae", {}).get("store_widget_state", False))
+    if not store_widget_state:
+        nb.metadata.pop("widgets", None)
     if parameters:
         inject_parameters(nb, parameters)
     for cell in nb.cells:  # timestamps of an earlier run would only churn the committed file

@@ -36,4 +36,24 @@ WRONG_ANSWERS = {
             'lib_sq = 0.0\n'
         ),
     },
+    3: {
+        "section 2's obtuse pair reused (not negative enough)": (
+            'P3, T3 = P.copy(), T2.copy()\n'
+            'c_neg = float(cotangent_weights(P3, T3, clamp=False)[edge_index(edges(T3), 0, 1)])\n'
+        ),
+        'the clamped weight instead of the raw one': (
+            'P3 = np.array([[0.0, 0, 0], [2.0, 0, 0], [1.0, 0.05, 0], [1.0, -0.05, 0]])\n'
+            'T3 = np.array([[0, 1, 2], [1, 0, 3]])\n'
+            'c_neg = float(cotangent_weights(P3, T3)[edge_index(edges(T3), 0, 1)])\n'
+        ),
+        'a folded pair: both apexes on the same side of the edge': (
+            'P3 = np.array([[0.0, 0, 0], [2.0, 0, 0], [1.0, 0.05, 0], [1.0, 0.1, 0]])\n'
+            'T3 = np.array([[0, 1, 2], [1, 0, 3]])\n'
+            'c_neg = float(cotangent_weights(P3, T3, clamp=False)[edge_index(edges(T3), 0, 1)])\n'
+        ),
+        'a weight below -5 typed in for a pair that does not have it': (
+            'P3, T3 = P.copy(), T2.copy()\n'
+            'c_neg = -19.95\n'
+        ),
+    },
 }
