@@ -129,3 +129,23 @@ DEFAULT_INFERENCE = "gauss-newton"
 #: Jacobians per mesh of the Gauss-Newton inference (measured on samba, pdance and pcow: the error
 #: falls by <2% after the fourth).
 GAUSS_NEWTON_ITERATIONS = 4
+
+# --- limits: work bounded before it starts, names cut in messages (issue 39) ----------------------
+#: the most vertex positions one run of ``meshvae generate`` or ``meshvae interpolate`` decodes and
+#: writes (meshes x vertices): 2e7 vertices are 0.5 GB of float64 positions and, for RIMD features
+#: (about 24 numbers per vertex), 2 GB of float32 decoder output. A larger -n or --steps is refused
+#: before any work, with the size and this limit.
+MAX_OUTPUT_VERTICES = 20_000_000
+#: the most parameters a network ``meshvae train`` builds may have (weights of the encoder and the
+#: decoder; Adam keeps two more copies): 2e8 float32 are 0.8 GB, 2.4 GB with Adam's moments.
+MAX_NETWORK_PARAMETERS = 200_000_000
+#: the most training epochs ``meshvae train --epochs`` accepts (a typo like 1e9 would never end).
+MAX_EPOCHS = 1_000_000
+#: the most Gauss-Newton steps per mesh ``meshvae evaluate --fit-latent`` and local/global rounds
+#: ``meshvae reconstruct --iterations`` accept (each step decodes D + 1 meshes or solves once more).
+MAX_SOLVER_STEPS = 1_000
+#: names (of meshes, files, label values) are cut to this many characters in error messages...
+MESSAGE_NAME_CHARS = 60
+#: ...and a mesh name to this many characters when it becomes part of a file name (file systems
+#: allow 255 bytes).
+FILE_NAME_CHARS = 100

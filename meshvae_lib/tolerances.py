@@ -167,3 +167,10 @@ GN_UNUSED_DIM_RTOL = 1e-9
 #: FeatureKind.linearize for a kind without an analytic linearisation: forward-difference step,
 #: relative to 1 + the feature row's norm (about the square root of float64's epsilon).
 FD_LINEARIZE_STEP = 1e-7
+
+# --- input range (issue 39) ---------------------------------------------------------------------
+#: the largest coordinate magnitude a mesh may have. The geometry multiplies up to six coordinates
+#: (squared lengths, areas, the determinant of a one-ring's 3x3 matrix): at 1e40 that is 1e240, far
+#: from float64's 1.8e308; a mesh beyond it is refused (its squares overflow) instead of turning into
+#: infinities and NaN deep in a solver. Scale such a mesh down first.
+MAX_ABS_COORDINATE = 1e40

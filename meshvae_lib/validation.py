@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvae_lib.input_checks import check_coordinate_range
+
 __all__ = [
     "check_faces",
     "check_vertices",
@@ -107,7 +109,8 @@ def check_vertices(V, name: str = "vertices", *, batch: bool | None = None,
     n_vertices : int, optional
         When given, the number of vertices must be exactly this.
     finite : bool
-        Also refuse NaN and infinite coordinates.
+        Also refuse NaN and infinite coordinates, and coordinates whose squares overflow
+        (:func:`~meshvae_lib.input_checks.check_coordinate_range`).
 
     Returns
     -------
@@ -126,6 +129,7 @@ def check_vertices(V, name: str = "vertices", *, batch: bool | None = None,
         raise ValueError(f"{name} must have shape {expected}, got {V.shape}")
     if finite:
         check_finite(V, name, "coordinates")
+        check_coordinate_range(V, name)
     return V
 
 

@@ -6,10 +6,15 @@ returns an exit code). This module holds what the commands share, importable wit
 torch so that ``--help`` stays fast:
 
 - the conventions, applied in one place, :func:`main`: exit status ``EXIT_OK`` (0),
-  ``EXIT_FAILURE`` (1: the command failed on valid input, :class:`CommandFailed` or an I/O error)
-  and ``EXIT_USAGE`` (2: bad usage or a bad value, :class:`UsageError`, ``ValueError`` or a missing
-  file); results and "wrote ..." lines go to stdout (:func:`result`), progress, warnings and
-  errors to stderr (:func:`note`);
+  ``EXIT_FAILURE`` (1: the command failed on valid input, :class:`CommandFailed` or an I/O error
+  such as ``cannot write FILE: reason``), ``EXIT_USAGE`` (2: bad usage or a bad value,
+  :class:`UsageError`, ``ValueError`` or a missing file) and ``EXIT_INTERRUPTED`` (130: Ctrl-C,
+  reported as ``interrupted`` without a traceback); results and "wrote ..." lines go to stdout
+  (:func:`result`), progress, warnings and errors to stderr (:func:`note`);
+- the checks every command makes before any work: the output can be written
+  (:func:`check_output`; outputs are written atomically by the library's writers,
+  :mod:`meshvae_lib.atomic`), and sizes that follow from options fit a stated budget
+  (:func:`check_budget`, :func:`check_at_most`);
 - the shared arguments (:func:`add_model_argument`, :func:`add_output_argument`,
   :func:`add_allow_degenerate`) and the one resolver of a mesh given on the command line as an
   index, a mesh name or a file (:func:`resolve_mesh`).
@@ -43,13 +48,22 @@ EXIT_OK = 0
 EXIT_FAILURE = 1
 #: exit status: bad usage or a bad value, for the user to fix in the command (argparse's own code).
 EXIT_USAGE = 2
+#: an error message longer than this is cut in the middle (names are cut earlier, where they are
+#: formatted; this is the backstop).
+MESSAGE_CHARS = 500
+#: exit status: interrupted by Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
 
 EPILOG = """\
 exit status:
   0  success
   1  the command failed on valid input: e.g. training diverged, or an I/O error while writing
   2  bad usage or a bad value, to fix in the command: an unknown option, a value out of range, a
-     missing or unknown file or mesh name, a damaged checkpoint, a model that does not fit the data
+     missing or unknown file or mesh name, a damaged checkpoint, a model that does not fit the data,
+     an output that cannot be written (all checked before any work)
+  130  interrupted (Ctrl-C): nothing half-written is left
+
+outputs are written atomically: a failed write ("cannot write FILE: reason") keeps the old file.
 
 output: results and "wrote ..." lines go to stdout; progress bars, warnings and errors
 (one line: "meshvae COMMAND: error: ...") go to stderr.
@@ -106,6 +120,51 @@ def check_at_least(value: int, minimum: int, option: str, why: str = "") -> None
         raise UsageError(f"{option} must be >= {minimum}{f' ({why})' if why else ''}, got {value}")
 
 
+def check_at_most(value: int, maximum: int, option: str, why: str = "") -> None:
+    """:class:`UsageError` unless ``value <= maximum`` (``why``: the budget, for the message)."""
+    if value > maximum:
+        raise UsageError(f"{option} must be <= {maximum:,}{f' ({why})' if why else ''}, got {value:,}")
+
+
+def check_number(value: float, option: str, *, positive: bool = True) -> None:
+    """:class:`UsageError` unless ``value`` is a finite number (and > 0 when ``positive``)."""
+    import math
+
+    if not math.isfinite(value) or (positive and value <= 0):
+        raise UsageError(f"{option} must be a finite number{' > 0' if positive else ''}, got {value}")
+
+
+def check_budget(n_meshes: int, n_vertices: int, option: str) -> None:
+    """:class:`UsageError` unless ``n_meshes`` meshes of ``n_vertices`` vertices fit in one run's
+    budget of ``MAX_OUTPUT_VERTICES`` decoded vertices (``defaults``); the message gives the size,
+    the limit and the largest ``option`` that fits."""
+    from meshvae_lib.defaults import MAX_OUTPUT_VERTICES
+
+    total = n_meshes * n_vertices
+    if total > MAX_OUTPUT_VERTICES:
+        most = max(MAX_OUTPUT_VERTICES // max(n_vertices, 1), 1)
+        raise UsageError(f"{option} {n_meshes:,} asks for {n_meshes:,} meshes of {n_vertices:,} vertices ="
+                         f" {total:,} vertices (about {total * 24 / 2**30:.3g} GiB of float64 positions); the"
+                         f" limit is {MAX_OUTPUT_VERTICES:,} vertices per run: {option} <= {most:,} for this"
+                         " model (run several times for more)")
+
+
+def check_output(path, *, collection: bool = False, parents: bool = False):
+    """The ``-o`` of a command, checked before any work: :class:`UsageError` unless it can be
+    written (``meshvae_lib.atomic.check_writable``). ``collection``: an ``.npz`` file when ``path``
+    ends in ``.npz``, else a folder; ``parents``: missing parent folders will be created. Returns
+    the path as a ``Path``."""
+    from pathlib import Path
+
+    from meshvae_lib.atomic import check_writable
+
+    path = Path(path)
+    try:
+        return check_writable(path, folder=collection and path.suffix.lower() != ".npz", parents=parents)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+
+
 def add_model_argument(parser: argparse.ArgumentParser) -> None:
     """The ``MODEL.pt`` positional of every command that reads a checkpoint."""
     parser.add_argument("model", metavar="MODEL.pt", help="checkpoint written by `meshvae train`")
@@ -137,7 +196,10 @@ class ChosenMesh:
     file: str | None = None
 
     def describe(self) -> str:
-        return f"file {self.file}" if self.file is not None else f"mesh {self.name!r} (index {self.index})"
+        from meshvae_lib.input_checks import short_name
+
+        return (f"file {self.file}" if self.file is not None
+                else f"mesh {short_name(repr(self.name))} (index {self.index})")
 
 
 def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: int | None = None,
@@ -155,6 +217,8 @@ def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: 
     Raises :class:`UsageError` for an index out of range, a ``spec`` that names nothing, or a file
     with another connectivity.
     """
+    from meshvae_lib.input_checks import short_name
+
     if collection is not None:
         n = len(collection)
         try:
@@ -172,9 +236,13 @@ def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: 
     from pathlib import Path
 
     path = Path(spec)
-    if not path.is_file():
+    try:
+        is_file = path.is_file()
+    except (OSError, ValueError):  # a name too long for the file system, a NUL byte
+        is_file = False
+    if not is_file:
         what = "neither an index, a mesh name of the collection, nor" if collection is not None else "not"
-        raise UsageError(f"{option} {spec!r} is {what} a mesh file{hint}")
+        raise UsageError(f"{option} {short_name(repr(spec))} is {what} a mesh file{hint}")
     import numpy as np
 
     from meshvae_lib.geometry.mesh_files import read_mesh
@@ -183,9 +251,9 @@ def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: 
     if faces is not None:
         faces = np.asarray(faces)
         if len(V) != n_vertices or F.shape != faces.shape or np.any(F != faces):
-            raise UsageError(f"{option} {path.name}: its connectivity ({len(V)} vertices, {len(F)} faces)"
+            raise UsageError(f"{option} {short_name(path.name)}: its connectivity ({len(V)} vertices, {len(F)} faces)"
                              f" differs from {owner} ({n_vertices} vertices, {len(faces)} faces)")
-    return ChosenMesh(V, path.stem, file=path.name)
+    return ChosenMesh(V, path.stem, file=short_name(path.name))
 
 
 # --- the command line --------------------------------------------------------------------------
@@ -217,7 +285,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command; returns its exit status (argparse errors, ``--help`` and ``--version``
-    raise ``SystemExit`` as argparse does: 2 and 0)."""
+    raise ``SystemExit`` as argparse does: 2 and 0; Ctrl-C returns ``EXIT_INTERRUPTED``)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # Ctrl-C before the command started (while parsing, importing)
+        print("meshvae: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -233,10 +309,15 @@ def main(argv: list[str] | None = None) -> int:
         if os.environ.get(ENV_VAR, "").strip():  # only then, so that commands without torch stay fast
             configure_threads()
         return int(args.func(args) or EXIT_OK)
+    except KeyboardInterrupt:  # Ctrl-C: the writers leave nothing half-written; no traceback
+        print(f"meshvae {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except Exception as exc:  # one line on stderr, no traceback; the status says whose fault it is
         status = exit_status(exc)
         expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
         text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
+        if len(text) > MESSAGE_CHARS:  # a long name or a library's long text: the start and the end
+            text = f"{text[: MESSAGE_CHARS - 200]} ... {text[-150:]}"
         if not expected:
             text += f" (run `meshvae -v {args.command} ...` for the traceback)"
         if args.verbose:

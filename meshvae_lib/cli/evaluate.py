@@ -7,7 +7,7 @@ import json
 
 from meshvae_lib.model.inference import INFERENCE_METHODS
 
-from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, result
+from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, check_at_most, result
 
 DESCRIPTION = """\
 Encode every mesh of DATA, decode it, align it rigidly to the original and report the mean
@@ -62,7 +62,12 @@ def run(args) -> int:
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.collection_io import read_collection
 
+    from meshvae_lib.defaults import MAX_SOLVER_STEPS
+
     check_at_least(args.fit_latent, 0, "--fit-latent")
+    check_at_most(args.fit_latent, MAX_SOLVER_STEPS, "--fit-latent", "Gauss-Newton steps per mesh")
+    if args.pca_components is not None:
+        check_at_least(args.pca_components, 1, "--pca-components")
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
     if args.fit_latent and args.inference not in (None, "finite-difference"):

@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from meshvae_lib.defaults import DEFAULT_LAYOUT, LAYOUTS
-from . import UsageError, add_allow_degenerate, add_command, add_output_argument, resolve_mesh, result
+from . import UsageError, add_allow_degenerate, add_command, add_output_argument, check_output, resolve_mesh, result
 
 logger = logging.getLogger(__name__)
 
@@ -53,6 +53,7 @@ def run(args) -> int:
         raise UsageError(f"the output must be an .npz file, got {out}")
     if not out.parent.is_dir():
         raise UsageError(f"folder does not exist: {out.parent}")
+    check_output(out)
     col = read_collection(args.data, allow_degenerate=args.allow_degenerate, progress=True)
     ref = resolve_mesh(args.reference, col, "--reference", allow_degenerate=args.allow_degenerate)
     logger.info("reference: %s", ref.describe())

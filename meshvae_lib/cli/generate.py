@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from . import UsageError, add_command, add_model_argument, add_output_argument, check_at_least, result
+from . import (UsageError, add_command, add_model_argument, add_output_argument, check_at_least, check_budget,
+               check_output, result)
 
 DESCRIPTION = """\
 Draw N latent vectors from the prior N(0, diag(sigma_object^2)) and decode them into meshes
@@ -52,7 +53,9 @@ def run(args) -> int:
         check_positive(args.temperature, "--temperature")
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    check_output(args.output, collection=True)
     model = load_model(args.model)
+    check_budget(args.n, len(model.reference_vertices), "-n")
     condition = dict(args.condition)
     if condition and not model.is_conditional:
         raise UsageError("this model was trained without labels; --condition needs a conditional model"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from . import (UsageError, add_allow_degenerate, add_command, add_model_argument, add_output_argument,
-               check_at_least, resolve_mesh, result)
+               check_at_least, check_budget, check_output, resolve_mesh, result)
 
 DESCRIPTION = """\
 Encode meshes A and B to their latent means, interpolate linearly in the latent space and decode
@@ -40,8 +40,10 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import read_collection, write_collection
 
     check_at_least(args.steps, 2, "--steps", "both ends are included")
+    check_output(args.output, collection=True)
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate) if args.data else None
     model = load_model(args.model, collection)
+    check_budget(args.steps, len(model.reference_vertices), "--steps")
     ends = [resolve_mesh(spec, collection, what, faces=model.faces, n_vertices=len(model.reference_vertices),
                          owner="the model's", allow_degenerate=args.allow_degenerate,
                          hint="" if collection is not None else " (to use an index, give --data DATA)")

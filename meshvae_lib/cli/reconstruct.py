@@ -6,8 +6,8 @@ import argparse
 import logging
 from pathlib import Path
 
-from meshvae_lib.defaults import RECONSTRUCTION_METHODS, ROTATION_RECOVERY
-from . import UsageError, add_command, add_output_argument, check_at_least, result
+from meshvae_lib.defaults import MAX_SOLVER_STEPS, RECONSTRUCTION_METHODS, ROTATION_RECOVERY
+from . import UsageError, add_command, add_output_argument, check_at_least, check_at_most, check_output, result
 
 logger = logging.getLogger(__name__)
 
@@ -50,10 +50,12 @@ def run(args) -> int:
 
     out = Path(args.output)
     check_at_least(args.iterations, 0, "--iterations")
+    check_at_most(args.iterations, MAX_SOLVER_STEPS, "--iterations", "local/global rounds per mesh")
     if out.suffix.lower() == ".npz" and not out.parent.is_dir():
         raise UsageError(f"folder does not exist: {out.parent}")
     if out.exists() and not out.is_dir() and out.suffix.lower() != ".npz":
         raise UsageError(f"{out} exists and is not a folder")
+    check_output(out, collection=True)
     data = load_features(args.features)
     rec = RIMDReconstructor(data["reference"], data["faces"], method=args.method,
                             layout=data["layout"], rotations=args.rotations,

@@ -7,7 +7,7 @@ import logging
 import time
 from pathlib import Path
 
-from . import UsageError, add_command, result
+from . import UsageError, add_command, check_output, result
 
 logger = logging.getLogger(__name__)
 
@@ -57,7 +57,9 @@ def run(args) -> int:
     if not args.name:
         raise UsageError(f"give a collection NAME (one of {', '.join(names)}) or --list")
     if args.name not in names:
-        raise UsageError(f"unknown collection {args.name!r}; choose one of {', '.join(names)}")
+        from meshvae_lib.input_checks import short_name
+
+        raise UsageError(f"unknown collection {short_name(repr(args.name))}; choose one of {', '.join(names)}")
     if not args.output:
         raise UsageError("give the output with -o OUT (a .npz file or a folder)")
     if args.seed < 0:
@@ -69,6 +71,13 @@ def run(args) -> int:
         raise UsageError(f"folder does not exist: {out.parent}")
     if out.exists() and not out.is_dir() and out.suffix.lower() != ".npz":
         raise UsageError(f"OUT must end in .npz or name a folder, got the file {out}")
+    if args.resolution is not None:
+        from data_synth import constants as C
+
+        if not C.MIN_RESOLUTION <= args.resolution <= C.MAX_RESOLUTION:
+            raise UsageError(f"--resolution must lie in [{C.MIN_RESOLUTION:,}, {C.MAX_RESOLUTION:,}] vertices,"
+                             f" got {args.resolution:,}")
+    check_output(out, collection=True)
     start = time.perf_counter()
     col = make_collection(args.name, seed=args.seed, resolution=args.resolution, noise=args.noise)
     logger.info("built %s in %.2f s", args.name, time.perf_counter() - start)

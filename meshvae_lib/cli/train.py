@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import argparse
 import logging
+import re
 
 from meshvae_lib.defaults import DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
+from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
-               note, result)
+               check_at_most, check_number, check_output, note, result)
 
 logger = logging.getLogger(__name__)
 
@@ -41,6 +43,60 @@ def _floats(text: str) -> list[float]:
     if not values or any(v <= 0 for v in values):
         raise argparse.ArgumentTypeError(f"expected positive numbers, got {text!r}")
     return values
+
+
+#: TrainConfig's fields as the command line names them (errors name the option, not the field).
+OPTIONS = {"epochs": "--epochs", "batch_size": "--batch-size", "lr": "--lr", "alpha": "--alpha",
+           "latent_dim": "--latent", "hidden": "--hidden", "sigma_object": "--sigma-object",
+           "prior_form": "--prior-form", "seed": "--seed", "init": "--init", "device": "--device",
+           "early_stopping": "--no-early-stopping", "progress": "--no-progress"}
+
+
+def _option_names(text: str) -> str:
+    """A library message with ``TrainConfig.<field>`` (or ``sigma_object``, ...) in the command
+    line's words: ``--epochs``."""
+    text = re.sub(r"TrainConfig\.(\w+)", lambda m: OPTIONS.get(m.group(1), m.group(0)), text)
+    return re.sub(r"\b(sigma_object|latent_dim|batch_size|holdout_every|reference_index)\b",
+                  lambda m: {"holdout_every": "--holdout-every", "reference_index": "--reference"}.get(
+                      m.group(1), OPTIONS.get(m.group(1), m.group(1))), text)
+
+
+def _check_device(text: str) -> None:
+    """:class:`UsageError` unless ``--device`` names a device this machine has ("auto", "cpu",
+    "cuda", "cuda:1", "mps")."""
+    if text == "auto":
+        return
+    import torch
+
+    from meshvae_lib.input_checks import short_name
+
+    try:
+        dev = torch.device(text)
+    except (RuntimeError, ValueError, TypeError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UsageError(f"--device {short_name(repr(text))} is not a device (auto, cpu, cuda, cuda:0, mps):"
+                         f" {short_name(reason, 120)}") from None
+    if dev.type == "cuda":
+        count = torch.cuda.device_count() if torch.cuda.is_available() else 0
+        if count == 0:
+            raise UsageError(f"--device {text}: this machine has no CUDA GPU that PyTorch can use"
+                             " (use --device cpu, or auto)")
+        if dev.index is not None and dev.index >= count:
+            raise UsageError(f"--device {text}: this machine has {count} CUDA GPU(s), cuda:0..cuda:{count - 1}")
+    elif dev.type == "mps":
+        if not (getattr(torch.backends, "mps", None) and torch.backends.mps.is_available()):
+            raise UsageError(f"--device {text}: Apple's MPS is not available here (use --device cpu, or auto)")
+    elif dev.type != "cpu":
+        raise UsageError(f"--device {text}: devices of type {dev.type!r} are not supported (auto, cpu, cuda, mps)")
+
+
+def _network_parameters(n_features: int, hidden, latent: int) -> int:
+    """About how many weights the encoder and the decoder of a network have (K -> hidden -> 2 x
+    latent, latent -> hidden reversed -> K)."""
+    sizes = [n_features, *hidden]
+    enc = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * 2 * latent
+    dec = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * latent
+    return enc + dec
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -91,19 +147,46 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import read_collection
     from meshvae_lib.model.train_config import TrainConfig, default_hidden
 
+    # every value is checked before the data is read and any training starts
     if args.latent is not None:
         check_at_least(args.latent, 1, "--latent")
     if args.sigma_object is not None and len(args.sigma_object) > (args.latent or DEFAULT_LATENT):
         raise UsageError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent or DEFAULT_LATENT}")
-    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
+    if args.epochs is not None:
+        check_at_least(args.epochs, 1, "--epochs")
+        check_at_most(args.epochs, MAX_EPOCHS, "--epochs")
+    check_at_least(args.batch_size, 2, "--batch-size")
+    check_number(args.lr, "--lr")
+    check_number(args.alpha, "--alpha")
+    for h in args.hidden or ():
+        check_at_least(h, 1, "--hidden")
+    if args.holdout_every != 0:
+        check_at_least(args.holdout_every, 2, "--holdout-every", "or 0 for none")
+    check_at_least(args.seed, 0, "--seed")
+    _check_device(args.device)
+    check_output(args.output, parents=True)  # model.save creates missing folders
     d = TrainConfig()
     epochs = args.epochs if args.epochs is not None else d.epochs
     hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
-    config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
-                         latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
-                         prior_form=args.prior_form, seed=args.seed, init=args.init,
-                         early_stopping=False if args.no_early_stopping else None,
-                         device=args.device, progress=not args.no_progress)
+    try:
+        config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
+                             latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
+                             prior_form=args.prior_form, seed=args.seed, init=args.init,
+                             early_stopping=False if args.no_early_stopping else None,
+                             device=args.device, progress=not args.no_progress)
+    except ValueError as exc:
+        raise UsageError(_option_names(str(exc))) from None
+    collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
+    if not -len(collection) <= args.reference < len(collection):
+        raise UsageError(f"--reference {args.reference} is out of range for {len(collection)} meshes"
+                         f" (0..{len(collection) - 1})")
+    n_features = (3 * collection.n_vertices if args.features != "rimd"
+                  else 6 * collection.n_vertices + 9 * len(collection.faces))  # RIMD: 6V + 6E, E <= 3F/2
+    n_params = _network_parameters(n_features, hidden, args.latent or PCA_LATENT_MAX)
+    if n_params > MAX_NETWORK_PARAMETERS:
+        raise UsageError(f"the network would have about {n_params:,} weights (K = {n_features:,} features,"
+                         f" --hidden {' '.join(map(str, hidden)) or '(none)'}, --latent {args.latent or 'auto'});"
+                         f" the limit is {MAX_NETWORK_PARAMETERS:,}: choose smaller --hidden or --latent")
     at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
     note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
          f" latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{epochs} epochs")
@@ -113,6 +196,8 @@ def run(args) -> int:
         model.fit(collection)
     except TrainingDiverged as exc:  # valid input, failed training: not the command's fault
         raise CommandFailed(str(exc)) from exc
+    except ValueError as exc:
+        raise UsageError(_option_names(str(exc))) from exc
     model.save(args.output)
     last = model.history_[-1]
     if model.selection_ is not None:

@@ -23,12 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
+from meshvae_lib.atomic import atomic_file, atomic_folder
+from meshvae_lib.defaults import FILE_NAME_CHARS
 from meshvae_lib.geometry.collection import MeshCollection, default_names
 from meshvae_lib.geometry.mesh_checks import validate_mesh
 from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
 from meshvae_lib.progress import progress as progress_bar
+from meshvae_lib.input_checks import check_numeric, short_name
 
-__all__ = ["read_collection", "write_collection", "natural_key"]
+__all__ = ["read_collection", "write_collection", "natural_key", "open_npz", "npz_array", "npz_names"]
 
 logger = logging.getLogger(__name__)
 
@@ -50,28 +53,61 @@ def _parse_label_column(values: list[str]) -> np.ndarray:
     return nums
 
 
+def _names(names) -> str:
+    """A few names for a message, each cut to a readable length."""
+    return "[" + ", ".join(short_name(repr(n)) for n in names) + "]"
+
+
 def _read_labels_csv(path: Path, names: list[str]) -> dict[str, np.ndarray]:
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    rows = [r for r in rows if any(c.strip() for c in r)]
+    """The label columns of a folder's ``labels.csv``: one row per mesh, in ``names``' order.
+
+    Raises ``ValueError`` naming the file and the line for a header without ``name`` first, an
+    empty row (blank lines at the end are allowed), a row with another number of fields, an empty
+    mesh name or label value, a mesh named twice, and rows missing or naming no mesh.
+    """
+    try:
+        with open(path, newline="") as fh:
+            rows = list(enumerate(csv.reader(fh), start=1))
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"{path}: is not a readable CSV file ({short_name(exc, 120)})") from None
+    while rows and not any(c.strip() for c in rows[-1][1]):  # blank lines at the end
+        rows.pop()
     if not rows:
         return {}
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip() for h in rows[0][1]]
     if not header or header[0] != "name":
-        raise ValueError(f"{path}: the first column must be 'name', got header {header}")
-    table = {}
-    for k, row in enumerate(rows[1:], start=2):
+        raise ValueError(f"{path}: the first column must be 'name', got header {_names(header[:5])}")
+    empty = [h for h in header[1:] if not h]
+    if empty or len(set(header)) != len(header):
+        raise ValueError(f"{path}: line {rows[0][0]}: the header needs distinct, non-empty column names,"
+                         f" got {_names(header[:8])}")
+    table: dict[str, list[str]] = {}
+    first_line: dict[str, int] = {}
+    for k, row in rows[1:]:
+        if not any(c.strip() for c in row):
+            raise ValueError(f"{path}: line {k} is empty; every row names a mesh and its labels")
         if len(row) != len(header):
             raise ValueError(
                 f"{path}: line {k} has {len(row)} fields, the header has {len(header)}"
             )
-        table[row[0].strip()] = [c.strip() for c in row[1:]]
+        cells = [c.strip() for c in row]
+        if not cells[0]:
+            raise ValueError(f"{path}: line {k} has an empty mesh name")
+        blank = [header[c] for c, v in enumerate(cells) if not v]
+        if blank:
+            raise ValueError(f"{path}: line {k} ({short_name(repr(cells[0]))}) has an empty value in column"
+                             f" {short_name(repr(blank[0]))}")
+        if cells[0] in table:
+            raise ValueError(f"{path}: line {k} names mesh {short_name(repr(cells[0]))} again (first on line"
+                             f" {first_line[cells[0]]}); give one row per mesh")
+        table[cells[0]] = cells[1:]
+        first_line[cells[0]] = k
     missing = [n for n in names if n not in table]
     if missing:
-        raise ValueError(f"{path}: no row for mesh(es) {missing[:5]}")
+        raise ValueError(f"{path}: no row for mesh(es) {_names(missing[:5])}")
     unknown = sorted(set(table) - set(names))
     if unknown:
-        raise ValueError(f"{path}: rows name meshes that are not in the folder: {unknown[:5]}")
+        raise ValueError(f"{path}: rows name meshes that are not in the folder: {_names(unknown[:5])}")
     return {
         col: _parse_label_column([table[n][c] for n in names])
         for c, col in enumerate(header[1:])
@@ -149,41 +185,100 @@ def read_collection(path, *, allow_degenerate: bool = False, progress: bool = Fa
 
 
 def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:
-        raise ValueError(f"{path.name}: cannot be read as .npz ({exc})") from exc
+    data = open_npz(path)
+    src = short_name(path.name)
     with data:
         for key in ("vertices", "faces"):
             if key not in data.files:
-                raise ValueError(f"{path.name}: has no {key!r} array (found {data.files})")
-        vertices = np.asarray(data["vertices"], dtype=np.float64)
-        faces = np.asarray(data["faces"])
+                raise ValueError(f"{src}: has no {key!r} array (found {_names(data.files[:10])})")
+        vertices = np.asarray(check_numeric(npz_array(data, "vertices", path), f"{src}: 'vertices'"),
+                              dtype=np.float64)
+        faces = check_numeric(npz_array(data, "faces", path), f"{src}: 'faces'")
         if vertices.ndim == 2:
             vertices = vertices[None]
         if vertices.ndim != 3 or vertices.shape[-1] != 3:
             raise ValueError(
-                f"{path.name}: 'vertices' must have shape (N, V, 3), got {vertices.shape}"
+                f"{src}: 'vertices' must have shape (N, V, 3), got {vertices.shape}"
             )
         if faces.ndim != 2 or faces.shape[1] != 3:
             raise ValueError(
-                f"{path.name}: 'faces' must be triangles with shape (F, 3), got {faces.shape}"
+                f"{src}: 'faces' must be triangles with shape (F, 3), got {faces.shape}"
             )
         n = len(vertices)
-        names = [str(s) for s in data["names"]] if "names" in data.files else default_names(n)
+        names = (npz_names(data, "names", path) if "names" in data.files else default_names(n))
         if len(names) != n:
-            raise ValueError(f"{path.name}: {len(names)} names for {n} meshes")
+            raise ValueError(f"{src}: {len(names)} names for {n} meshes")
         labels = {}
         for key in data.files:
             if key.startswith("label_"):
-                val = np.asarray(data[key])
+                val = npz_array(data, key, path)
+                if val.dtype.kind not in "biufUS":
+                    raise ValueError(f"{src}: {short_name(repr(key))} must hold numbers or text, got dtype {val.dtype}")
                 if val.shape != (n,):
                     raise ValueError(
-                        f"{path.name}: {key!r} must have shape ({n},), got {val.shape}"
+                        f"{src}: {short_name(repr(key))} must have shape ({n},), got {val.shape}"
                     )
                 labels[key[len("label_"):]] = val
-    _validate_collection(vertices, faces, names, path.name, allow_degenerate)
+    _validate_collection(vertices, faces, names, src, allow_degenerate)
     return MeshCollection(vertices, faces.astype(np.int64), names, labels)
+
+
+def open_npz(path):
+    """``np.load(path)`` without pickles, with errors that name the file and never advise loading
+    it with pickles (which would run whatever code a foreign file holds).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    NpzFile (use it as a context manager)
+
+    Raises
+    ------
+    ValueError
+        The file is not an ``.npz`` archive (or is damaged).
+    """
+    path = Path(path)
+    try:
+        data = np.load(path, allow_pickle=False)
+    except Exception as exc:
+        raise ValueError(f"{short_name(path.name)}: cannot be read as .npz ({_npz_reason(exc)})") from None
+    if not hasattr(data, "files"):  # a plain .npy file under an .npz name
+        raise ValueError(f"{short_name(path.name)}: is a single .npy array, not an .npz archive of named arrays")
+    return data
+
+
+def _npz_reason(exc: BaseException) -> str:
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    if "allow_pickle" in text or "pickle" in text.lower():
+        return "it holds Python objects (pickled data), which are never loaded"
+    return short_name(text, 160)
+
+
+def npz_array(data, key: str, path) -> np.ndarray:
+    """Array ``key`` of an open ``.npz`` (:func:`open_npz`), with errors that name the file and the
+    array: an array of Python objects is refused (it would need a pickle), never loaded.
+
+    Returns
+    -------
+    ndarray
+    """
+    try:
+        return np.asarray(data[key])
+    except Exception as exc:  # ValueError: object arrays; zipfile/zlib errors: damaged member
+        raise ValueError(f"{short_name(Path(path).name)}: array {short_name(repr(key))} cannot be read"
+                         f" ({_npz_reason(exc)}); store numbers or text (fixed-width strings)") from None
+
+
+def npz_names(data, key: str, path) -> list[str]:
+    """A 1-D array of names (text or numbers) of an open ``.npz``, as a list of str."""
+    val = npz_array(data, key, path)
+    if val.dtype.kind not in "biuUS" or val.ndim != 1:
+        raise ValueError(f"{short_name(Path(path).name)}: {key!r} must be a 1-D array of text or whole numbers,"
+                         f" got dtype {val.dtype} and shape {val.shape}")
+    return [v.decode(errors="replace") if isinstance(v, bytes) else str(v) for v in val.tolist()]
 
 
 def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshCollection:
@@ -221,8 +316,14 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
     """Write a collection to an ``.npz`` (when ``path`` ends in ``.npz``) or to a folder.
 
     A folder gets one OBJ file per mesh, named after the mesh when the names are usable as file
-    names and keep their order under natural sort (else numbered ``0000_<name>.obj``), plus
-    ``labels.csv`` when there are labels. Positions keep full float64 precision in both formats.
+    names and keep their order under natural sort (else numbered ``0000_<name>.obj``, the name cut
+    to ``FILE_NAME_CHARS`` characters), plus ``labels.csv`` when there are labels. Positions keep full
+    float64 precision in both formats.
+
+    Writing is atomic (:mod:`meshvae_lib.atomic`): the ``.npz`` through a temporary file, the folder
+    through a temporary folder whose files then take their places (other files in an existing
+    folder are left alone). A failed write leaves the old output as it was and raises
+    :class:`~meshvae_lib.atomic.OutputError` (``cannot write FILE: reason``).
 
     Parameters
     ----------
@@ -254,25 +355,27 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
         arrays = {"vertices": col.vertices, "faces": col.faces, "names": np.array(col.names)}
         for key, val in col.labels.items():
             arrays[f"label_{key}"] = val
-        np.savez_compressed(path, **arrays)
+        with atomic_file(path) as fh:
+            np.savez_compressed(fh, **arrays)
         return path
-    path.mkdir(parents=True, exist_ok=True)
     stems = list(col.names)
-    safe = all(re.fullmatch(r"[\w.+-]+", s) for s in stems) and len(set(stems)) == len(stems)
+    safe = (all(re.fullmatch(r"[\w.+-]+", s) and len(s) <= FILE_NAME_CHARS for s in stems)
+            and len(set(stems)) == len(stems))
     if not safe or sorted(stems, key=natural_key) != stems:
         width = max(4, len(str(len(stems) - 1)))
         stems = [
-            f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)}" for k, s in enumerate(stems)
+            f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)[:FILE_NAME_CHARS]}" for k, s in enumerate(stems)
         ]
-    for V, stem in zip(col.vertices, stems):
-        write_mesh(path / f"{stem}.obj", V, col.faces)
-    if col.labels:
-        with open(path / "labels.csv", "w", newline="") as fh:
-            w = csv.writer(fh)
-            keys = list(col.labels)
-            w.writerow(["name", *keys])
-            for k, stem in enumerate(stems):
-                w.writerow([stem, *[_fmt_label(col.labels[c][k]) for c in keys]])
+    with atomic_folder(path) as tmp:
+        for V, stem in zip(col.vertices, stems):
+            write_mesh(tmp / f"{stem}.obj", V, col.faces)
+        if col.labels:
+            with open(tmp / "labels.csv", "w", newline="") as fh:
+                w = csv.writer(fh)
+                keys = list(col.labels)
+                w.writerow(["name", *keys])
+                for k, stem in enumerate(stems):
+                    w.writerow([stem, *[_fmt_label(col.labels[c][k]) for c in keys]])
     return path
 
 

@@ -1,7 +1,7 @@
 """What makes a triangle mesh usable here, and the fix for the most common defect.
 
 :func:`validate_mesh` refuses, with a ``ValueError`` naming the mesh and the first offending vertex
-or face: non-finite coordinates, faces that are not triangles, face indices out of range, faces
+or face: non-finite coordinates, coordinates whose squares overflow (``MAX_ABS_COORDINATE``), faces that are not triangles, face indices out of range, faces
 that repeat a vertex, vertices that no face uses, and zero-area faces (unless
 ``allow_degenerate=True``). Reading a mesh file (:mod:`meshvae_lib.geometry.mesh_files`) or a
 collection (:mod:`meshvae_lib.geometry.collection_io`) runs it on every mesh.
@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib import tolerances as tol
+from meshvae_lib.input_checks import check_coordinate_range
 from meshvae_lib.validation import check_faces, check_vertices
 
 __all__ = ["validate_mesh", "remove_unreferenced_vertices"]
@@ -35,7 +36,7 @@ def validate_mesh(V, F, *, name: str = "mesh", allow_degenerate: bool = False) -
     Raises
     ------
     ValueError
-        Wrong shapes, non-finite coordinates, indices out of range, faces repeating a vertex,
+        Wrong shapes, non-finite or too large coordinates, indices out of range, faces repeating a vertex,
         unreferenced vertices, or (unless allowed) zero-area faces. The message names the first
         offending vertex or face.
     """
@@ -56,6 +57,7 @@ def validate_mesh(V, F, *, name: str = "mesh", allow_degenerate: bool = False) -
             f"{name}: {int(bad.sum())} vertices have NaN or infinite coordinates "
             f"(first: vertex {k} = {V[k].tolist()})"
         )
+    check_coordinate_range(V, f"{name}: vertices")
     n = len(V)
     if F.min() < 0 or F.max() >= n:
         raise ValueError(

@@ -13,7 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+from meshvae_lib.atomic import atomic_file
 from meshvae_lib.geometry.mesh_checks import validate_mesh
+from meshvae_lib.input_checks import short_name
 from meshvae_lib.validation import check_mesh
 
 __all__ = ["MESH_SUFFIXES", "read_mesh", "write_mesh"]
@@ -23,38 +25,103 @@ MESH_SUFFIXES = (".obj", ".ply", ".off")
 
 
 def _polygon_corners_in_text(path: Path) -> int:
-    """Largest number of corners of a face in an OBJ or ASCII OFF file (3 for triangle meshes)."""
+    """Largest number of corners of a face in an OBJ or ASCII OFF file (3 for triangle meshes).
+
+    Also checks what trimesh would pass over silently or report without a line: a face with fewer
+    than three corners, and a face index that names no vertex (OBJ counts from 1, or from the end
+    with negative indices, so 0 is never valid; OFF counts from 0). Raises ``ValueError`` naming
+    the file and the line.
+    """
     suffix = path.suffix.lower()
     try:
         text = path.read_text(errors="replace")
     except UnicodeDecodeError:  # pragma: no cover - binary file
         return 3
-    most = 3
+    name = short_name(path.name)
     if suffix == ".obj":
-        for line in text.splitlines():
-            if line.startswith("f ") or line.startswith("f\t"):
-                most = max(most, len(line.split()) - 1)
-    elif suffix == ".off":
-        lines = [ln.split("#")[0].split() for ln in text.splitlines()]
-        lines = [ln for ln in lines if ln]
-        if not lines:
+        return _check_obj_faces(text, name)
+    if suffix == ".off":
+        return _check_off_faces(text, name)
+    return 3
+
+
+def _face_line(faces: list, counts: np.ndarray, k: int) -> int:
+    """The line number of corner ``k`` of the flattened face corners."""
+    return faces[int(np.searchsorted(np.cumsum(counts), k, side="right"))][0]
+
+
+def _check_obj_faces(text: str, name: str) -> int:
+    """:func:`_polygon_corners_in_text` for an OBJ file's text (vectorised over the corners)."""
+    most = 3
+    faces = []  # (line number, corner tokens, vertices defined before the line)
+    n_vertices = 0
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        if line.startswith("v ") or line.startswith("v\t"):
+            n_vertices += 1
+        elif line.startswith("f ") or line.startswith("f\t"):
+            faces.append((lineno, line.split("#")[0].split()[1:], n_vertices))
+    if not faces:
+        return most
+    counts = np.array([len(c) for _, c, _ in faces])
+    if counts.min() < 3:
+        lineno, corners, _ = faces[int(np.argmin(counts))]
+        raise ValueError(f"{name}: line {lineno}: a face with {len(corners)} corner(s); a face needs at"
+                         " least three")
+    most = int(counts.max())
+    tokens = np.char.partition(np.array([c for _, cs, _ in faces for c in cs]), "/")[:, 0]
+    try:
+        idx = tokens.astype(np.int64)
+    except ValueError:
+        k = next(i for i, t in enumerate(tokens.tolist()) if not t.lstrip("+-").isdigit())
+        lineno = _face_line(faces, counts, k)
+        raise ValueError(f"{name}: line {lineno}: face corner {short_name(repr(str(tokens[k])))} is not a"
+                         " vertex index") from None
+    before = np.repeat(np.array([n for _, _, n in faces]), counts)
+    # OBJ counts from 1 (any vertex of the file), or back from the last vertex defined (negative)
+    bad = (idx == 0) | (idx > n_vertices) | ((idx < 0) & (-idx > before))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        lineno = _face_line(faces, counts, k)
+        raise ValueError(f"{name}: line {lineno}: face index {int(idx[k])} names no vertex (OBJ counts from"
+                         f" 1; the file has {n_vertices} vertices)")
+    return most
+
+
+def _check_off_faces(text: str, name: str) -> int:
+    """:func:`_polygon_corners_in_text` for an ASCII OFF file's text."""
+    most = 3
+    lines = [(k, ln.split("#")[0].split()) for k, ln in enumerate(text.splitlines(), start=1)]
+    lines = [(k, ln) for k, ln in lines if ln]
+    if not lines:
+        return 3
+    head = lines[0][1]
+    start = 1
+    if head[0].upper().endswith("OFF") and len(head) == 1:
+        if len(lines) < 2:
             return 3
-        head = lines[0]
-        start = 1
-        if head[0].upper().endswith("OFF") and len(head) == 1:
-            counts = lines[1]
-            start = 2
-        else:
-            counts = head[1:] if head[0].upper().endswith("OFF") else head
+        counts = lines[1][1]
+        start = 2
+    else:
+        counts = head[1:] if head[0].upper().endswith("OFF") else head
+    try:
+        nv, nf = int(counts[0]), int(counts[1])
+    except (ValueError, IndexError):
+        return 3
+    for lineno, ln in lines[start + nv : start + nv + nf]:
         try:
-            nv, nf = int(counts[0]), int(counts[1])
-        except (ValueError, IndexError):
-            return 3
-        for ln in lines[start + nv : start + nv + nf]:
-            try:
-                most = max(most, int(ln[0]))
-            except ValueError:
-                pass
+            n = int(ln[0])
+            idx = [int(v) for v in ln[1 : 1 + n]]
+        except ValueError:
+            raise ValueError(f"{name}: line {lineno}: a face line must be whole numbers, got"
+                             f" {short_name(' '.join(ln))!r}") from None
+        if n < 3 or len(idx) < n:
+            raise ValueError(f"{name}: line {lineno}: a face with {min(n, len(idx))} corner(s); a face"
+                             " needs at least three")
+        bad = [v for v in idx if not 0 <= v < nv]
+        if bad:
+            raise ValueError(f"{name}: line {lineno}: face index {bad[0]} names no vertex (OFF counts"
+                             f" from 0; the file has {nv} vertices)")
+        most = max(most, n)
     return most
 
 
@@ -91,35 +158,35 @@ def read_mesh(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such mesh file: {path}")
-    if not triangulate and path.suffix.lower() in (".obj", ".off"):
+    if path.suffix.lower() in (".obj", ".off"):
         corners = _polygon_corners_in_text(path)
-        if corners > 3:
+        if corners > 3 and not triangulate:
             raise ValueError(
-                f"{path.name}: has faces with {corners} corners; only triangle meshes are "
+                f"{short_name(path.name)}: has faces with {corners} corners; only triangle meshes are "
                 "supported (triangulate it, or read it with triangulate=True)"
             )
     try:
         mesh = trimesh.load(path, process=False, maintain_order=True, force="mesh")
     except Exception as exc:  # trimesh raises many kinds of errors for unreadable files
-        raise ValueError(f"{path.name}: cannot be read as a mesh ({exc})") from exc
+        raise ValueError(f"{short_name(path.name)}: cannot be read as a mesh ({short_name(exc, 200)})") from exc
     V = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
     F = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
     if F.size == 0:
-        raise ValueError(f"{path.name}: holds no triangles")
+        raise ValueError(f"{short_name(path.name)}: holds no triangles")
     if validate:
-        validate_mesh(V, F, name=path.name, allow_degenerate=allow_degenerate)
+        validate_mesh(V, F, name=short_name(path.name), allow_degenerate=allow_degenerate)
     return V, F
 
 
 def _write_obj(path: Path, V: np.ndarray, F: np.ndarray) -> None:
-    with open(path, "w") as fh:
+    with atomic_file(path, "w") as fh:
         fh.write(f"# {len(V)} vertices, {len(F)} faces\n")
         np.savetxt(fh, V, fmt="v %.17g %.17g %.17g")
         np.savetxt(fh, F + 1, fmt="f %d %d %d")
 
 
 def _write_off(path: Path, V: np.ndarray, F: np.ndarray) -> None:
-    with open(path, "w") as fh:
+    with atomic_file(path, "w") as fh:
         fh.write(f"OFF\n{len(V)} {len(F)} 0\n")
         np.savetxt(fh, V, fmt="%.17g %.17g %.17g")
         np.savetxt(fh, F, fmt="3 %d %d %d")
@@ -135,7 +202,7 @@ def _write_ply(path: Path, V: np.ndarray, F: np.ndarray) -> None:
     faces = np.zeros(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))])
     faces["n"] = 3
     faces["v"] = F
-    with open(path, "wb") as fh:
+    with atomic_file(path, "wb") as fh:
         fh.write(header.encode("ascii"))
         fh.write(np.ascontiguousarray(V, dtype="<f8").tobytes())
         fh.write(faces.tobytes())
@@ -145,7 +212,9 @@ def write_mesh(path, V, F) -> Path:
     """Write one triangle mesh; the suffix picks the format (``.obj``, ``.off``, ``.ply``).
 
     OBJ and OFF are written as text with 17 significant digits and PLY as binary float64, so
-    positions survive a round trip exactly.
+    positions survive a round trip exactly. The file is written atomically
+    (:func:`~meshvae_lib.atomic.atomic_file`): a failed write leaves an older file as it was and
+    raises :class:`~meshvae_lib.atomic.OutputError` (``cannot write FILE: reason``).
 
     Parameters
     ----------

@@ -120,8 +120,22 @@ def polar_rs_soa(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Rotations (``det = +1``).
     s : (9, m) float64
         Symmetric factors, ``r @ s == t``.
+
+    Raises
+    ------
+    ValueError
+        If some matrix has NaN or infinite entries (the Newton iteration is capped at
+        ``POLAR_MAX_ITERATIONS``; a matrix it does not handle goes to the SVD, which needs finite
+        entries).
     """
-    u, det_t, ok, _ = _polar_soa(t)
+    bad_t = ~np.isfinite(t).all(axis=0)
+    if bad_t.any():  # LAPACK's SVD may never return on NaN or infinite entries
+        k = int(np.flatnonzero(bad_t)[0])
+        raise ValueError(f"polar decomposition: {int(bad_t.sum())} of {t.shape[1]} matrices have NaN or infinite"
+                         f" entries (first: matrix {k}); the coordinates or features they come from overflowed")
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        u, det_t, ok, _ = _polar_soa(t)
+    ok &= np.isfinite(u).all(axis=0) & np.isfinite(det_t)  # Newton overflowed: SVD instead
     s = matmul_soa(u, t, transpose_a=True)
     # symmetrise
     for i, j in ((0, 1), (0, 2), (1, 2)):

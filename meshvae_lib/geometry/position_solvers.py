@@ -304,6 +304,9 @@ class ExactPositionSolver(_PinnedSolve):
                 steps -= 1
                 break
             dP = self._gn_lu.solve(np.ascontiguousarray(self._Kt @ res))
+            if not np.isfinite(dP).all():
+                raise ValueError("exact reconstruction: a Gauss-Newton step gave NaN or infinite positions;"
+                                 " the features are too large for float64")
             P = P - dP
             if np.max(np.abs(dP)) < tol.EXACT_REFINE_TOL * self._diag:
                 break

@@ -207,7 +207,11 @@ class RIMDReconstructor:
             log_dR, S = self.layout.unpack(f[k])
             w = np.ascontiguousarray(log_dR[0].T)
             Ssoa = np.ascontiguousarray(S[0].reshape(n, 9).T)
-            out[k] = self._reconstruct_one(w, Ssoa)
+            with np.errstate(over="ignore", invalid="ignore"):  # reported just below, once
+                out[k] = self._reconstruct_one(w, Ssoa)
+            if not np.isfinite(out[k]).all():  # the alignment's SVD may never return on NaN
+                raise ValueError(f"features row {k}: the reconstructed positions overflowed float64 (NaN or"
+                                 " infinite); its stretch entries are too large")
         if align:
             out = rigid_align(out, self.V0)
         return out[0] if single else out

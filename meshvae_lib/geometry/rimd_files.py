@@ -14,9 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from meshvae_lib.defaults import DEFAULT_LAYOUT
+from meshvae_lib.atomic import atomic_file
+from meshvae_lib.defaults import DEFAULT_LAYOUT, LAYOUTS
+from meshvae_lib.geometry.collection_io import npz_array, npz_names, open_npz
 from meshvae_lib.geometry.rimd import RIMDLayout
-from meshvae_lib.validation import check_rows
+from meshvae_lib.input_checks import check_numeric, short_name
+from meshvae_lib.validation import check_faces, check_finite, check_rows, check_vertices
 
 __all__ = ["FEATURE_FILE_KEYS", "save_features", "load_features"]
 
@@ -27,7 +30,8 @@ FEATURE_FILE_KEYS = ("features", "reference", "faces", "names", "layout")
 
 def save_features(path, features, reference, faces, names=None, labels=None,
                   layout: str = DEFAULT_LAYOUT) -> None:
-    """Write a feature file (``.npz``, uncompressed, float64 kept).
+    """Write a feature file (``.npz``, uncompressed, float64 kept), atomically: a failed write
+    leaves an older file as it was and raises :class:`~meshvae_lib.atomic.OutputError`.
 
     Parameters
     ----------
@@ -63,7 +67,8 @@ def save_features(path, features, reference, faces, names=None, labels=None,
     }
     for key, val in (labels or {}).items():
         arrays[f"label_{key}"] = np.asarray(val)
-    np.savez(path, **arrays)
+    with atomic_file(path) as fh:
+        np.savez(fh, **arrays)
 
 
 def load_features(path) -> dict:
@@ -77,37 +82,48 @@ def load_features(path) -> dict:
     Raises
     ------
     FileNotFoundError, ValueError
-        Missing file, missing arrays, or a feature length that does not match the layout.
+        Missing file, missing arrays, arrays that are not real numbers (complex, text, Python
+        objects: never unpickled), NaN or infinite features, face indices out of range, or a
+        feature length that does not match the layout; the message names the file.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such feature file: {path}")
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:
-        raise ValueError(f"{path.name}: cannot be read as .npz ({exc})") from exc
+    data = open_npz(path)
+    src = short_name(path.name)
     with data:
         missing = [k for k in ("features", "reference", "faces") if k not in data.files]
         if missing:
-            raise ValueError(f"{path.name}: not a feature file, it lacks {missing} "
-                             f"(found {data.files}); make one with `meshvae features`")
+            raise ValueError(f"{src}: not a feature file, it lacks {missing} "
+                             f"(found {[short_name(f) for f in data.files[:10]]}); make one with `meshvae features`")
+        arrays = {k: check_numeric(npz_array(data, k, path), f"{src}: {k!r}")
+                  for k in ("features", "reference", "faces")}
+        layout = npz_array(data, "layout", path) if "layout" in data.files else np.array(DEFAULT_LAYOUT)
+        if layout.dtype.kind not in "US" or layout.shape != ():
+            raise ValueError(f"{src}: 'layout' must be one text value, got dtype {layout.dtype} and shape"
+                             f" {layout.shape}")
         out = {
-            "features": np.asarray(data["features"], dtype=np.float64),
-            "reference": np.asarray(data["reference"], dtype=np.float64),
-            "faces": np.asarray(data["faces"], dtype=np.int64),
-            "layout": str(data["layout"]) if "layout" in data.files else DEFAULT_LAYOUT,
-            "labels": {k[len("label_"):]: np.asarray(data[k]) for k in data.files
+            "features": np.asarray(arrays["features"], dtype=np.float64),
+            "reference": np.asarray(arrays["reference"], dtype=np.float64),
+            "faces": arrays["faces"],
+            "layout": str(layout),
+            "labels": {k[len("label_"):]: npz_array(data, k, path) for k in data.files
                        if k.startswith("label_")},
         }
         f = out["features"]
         if f.ndim == 1:
             f = out["features"] = f[None]
-        out["names"] = ([str(s) for s in data["names"]] if "names" in data.files
+        out["names"] = (npz_names(data, "names", path) if "names" in data.files
                         else [f"{k:04d}" for k in range(len(f))])
+    if out["layout"] not in LAYOUTS:
+        raise ValueError(f"{src}: unknown layout {short_name(repr(out['layout']))}; one of {LAYOUTS}")
+    out["reference"] = check_vertices(out["reference"], f"{src}: 'reference'", batch=False, finite=True)
+    out["faces"] = check_faces(out["faces"], n_vertices=len(out["reference"]), name=f"{src}: 'faces'")
+    check_finite(out["features"], f"{src}: 'features'")
     lay = RIMDLayout(out["faces"], len(out["reference"]), out["layout"])
     if f.ndim != 2 or f.shape[1] != lay.K:
-        raise ValueError(f"{path.name}: features have shape {f.shape}, but the {out['layout']!r} "
+        raise ValueError(f"{src}: features have shape {f.shape}, but the {out['layout']!r} "
                          f"layout of its reference mesh needs K = {lay.K}")
     if len(out["names"]) != len(f):
-        raise ValueError(f"{path.name}: {len(out['names'])} names for {len(f)} feature rows")
+        raise ValueError(f"{src}: {len(out['names'])} names for {len(f)} feature rows")
     return out

@@ -199,6 +199,9 @@ class RotationRecovery:
                     steps.append((R, np.zeros((self.n_vertices, 3))))
                 break
             omega = self._sync_lu.solve(np.ascontiguousarray(self._Gt @ delta.T))  # (n, 3)
+            if not np.isfinite(omega).all():
+                raise ValueError("rotation recovery: a global sweep gave NaN or infinite corrections; the"
+                                 f" features' rotations overflow float64 (log dR up to {np.abs(w).max():.3g})")
             if steps is not None:
                 steps.append((R, omega))
             R = matmul_soa(exp_soa(np.ascontiguousarray(omega.T)), R)

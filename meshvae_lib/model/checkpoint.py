@@ -12,14 +12,16 @@ broken model. Files of formats 1 and 2 are read too (:func:`read_checkpoint` upg
 from __future__ import annotations
 
 import hashlib
+import io
 import logging
-import os
 import re
 import zipfile
 from pathlib import Path
 
 import numpy as np
 import torch
+
+from meshvae_lib.atomic import atomic_file
 
 __all__ = ["write_checkpoint", "read_checkpoint", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
 
@@ -71,8 +73,9 @@ def write_checkpoint(path, state: dict) -> Path:
     """Write a model's ``state`` (:meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.state_dict`) to
     ``path`` as one checkpoint file (what ``model.save(path)`` does). Returns the path.
 
-    The file is written next to its destination and renamed, so an interrupted save never leaves a
-    half-written checkpoint under the final name.
+    The file is written next to its destination and renamed (:func:`~meshvae_lib.atomic.atomic_file`),
+    so an interrupted or failed save never leaves a half-written checkpoint under the final name; a
+    failed write raises :class:`~meshvae_lib.atomic.OutputError` (``cannot write FILE: reason``).
     """
     path = Path(path)
     if path.parent and not path.parent.exists():
@@ -86,13 +89,10 @@ def write_checkpoint(path, state: dict) -> Path:
         "network_state": network_state,
         "checksum": _checksum(network_state, state["kind"]["reference"], state["kind"]["faces"]),
     }
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    try:
-        torch.save(payload, tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    buffer = io.BytesIO()  # serialised first: torch reports a failed write as a RuntimeError, not an OSError
+    torch.save(payload, buffer)
+    with atomic_file(path) as fh:
+        fh.write(buffer.getbuffer())
     return path
 
 

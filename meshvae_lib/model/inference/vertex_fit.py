@@ -69,6 +69,8 @@ class VertexFit(InferenceStrategy):
             r0 = (target - P0).ravel()
             err = float(r0 @ r0) if err is None else err
             J = ((P[1:] - P0).reshape(len(used), -1) / self.step).T  # (3n, d)
+            if not (np.isfinite(J).all() and np.isfinite(r0).all()):
+                break  # a non-finite decode: LAPACK's least squares may not return on it; keep z
             dz, *_ = np.linalg.lstsq(J, r0, rcond=None)
             t = 1.0
             for _ in range(4):
