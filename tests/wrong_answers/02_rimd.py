@@ -4,6 +4,26 @@ Keys are exercise numbers from 1; values map a short description to the code run
 the solution (tests/test_exercise_checks.py runs them)."""
 
 WRONG_ANSWERS = {
+    1: {
+        'S compared without the factor s': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = float(np.abs(f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
+            's_change = float(np.abs(f_scaled[lay.scaling_slice] - f1[lay.scaling_slice]).max())\n'
+        ),
+        'the reference scaled too': (
+            's = 1.5\n'
+            'f_scaled = RIMDEncoder(s * V0, F).transform(s * V1)\n'
+            'rot_change = float(np.abs(f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
+            's_change = float(np.abs(f_scaled[lay.scaling_slice] - s * f1[lay.scaling_slice]).max())\n'
+        ),
+        'the mesh shifted by s instead of scaled': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(V1 + s)\n'
+            'rot_change = float(np.abs(f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
+            's_change = float(np.abs(f_scaled[lay.scaling_slice] - s * f1[lay.scaling_slice]).max())\n'
+        ),
+    },
     2: {
         'V_lin is the feature midpoint': (
             'Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n'
@@ -24,6 +44,30 @@ WRONG_ANSWERS = {
             "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
             'V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n'
             'stretch_mid, stretch_lin = (float(vertex_edge_stretch(X, V0, F).mean()) for X in (V_mid, V_lin))\n'
+        ),
+    },
+    3: {
+        'the angle copied from section 3 (1e-8)': (
+            'theta_bad = 1e-8\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(R32))) - theta_bad)\n'
+        ),
+        'the angle copied from section 3 near pi (3.14159255)': (
+            'theta_bad = 3.14159255\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(R32))) - theta_bad)\n'
+        ),
+        'the errors of section 3 typed in': (
+            'theta_bad = 1e-8\n'
+            'err_textbook, err_library = 1.0e-08, 1e-15\n'
+        ),
+        'float64 instead of float32': (
+            'theta_bad = 2e-4\n'
+            'R64 = so3_exp(theta_bad * axis)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R64) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(R64))) - theta_bad)\n'
         ),
     },
 }
