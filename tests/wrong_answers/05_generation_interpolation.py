@@ -3,5 +3,58 @@
 Keys are exercise numbers from 1; values map a short description to the code run in place of
 the solution (tests/test_exercise_checks.py runs them)."""
 
+_ROWS = (
+    'ref = model.reference_vertices\n'
+    'Xh = rimd_features(ref, held, coll.faces)\n'
+    'Xt = rimd_features(ref, train, coll.faces)\n'
+    '_, d_held = generation.nearest_neighbors(Xh, Xt)\n'
+)
+
+_GEN_PATH = (
+    'zg = model.sample_latent(2, seed=1)\n'
+    '_, gen_path = itp.LatentPath(model.decode_latent, zg[0], zg[1]).steps(N_STEPS)\n'
+)
+
+
+def _claimed(z_code: str) -> str:
+    """z_new from ``z_code``, with the novelty and stretch its decoded mesh really has."""
+    return (
+        z_code
+        + 'ref = model.reference_vertices\n'
+        'Xt = rimd_features(ref, train, coll.faces)\n'
+        '_, d_train = generation.nearest_neighbors(Xt, Xt, exclude_self=True)\n'
+        'V1 = model.decode_latent(np.asarray(z_new, dtype=float))\n'
+        '_, d1 = generation.nearest_neighbors(rimd_features(ref, V1[None], coll.faces), Xt)\n'
+        'new_novelty = float(d1[0] / np.median(d_train))\n'
+        'new_stretch = float(np.ravel(itp.edge_length_distortion(V1, coll.faces, train)[0])[0])\n'
+    )
+
+
 WRONG_ANSWERS = {
+    1: {
+        'the forbidden call (the generated shapes)': 'held_novelty = gen.novelty_ratio()\n',
+        'raw distances, not divided': _ROWS + 'held_novelty = d_held\n',
+        'the mean instead of the median': (
+            _ROWS + '_, d_train = generation.nearest_neighbors(Xt, Xt, exclude_self=True)\n'
+            'held_novelty = d_held / np.mean(d_train)\n'),
+        'training distances without exclude_self': (
+            _ROWS + '_, d_train = generation.nearest_neighbors(Xt, Xt)\n'
+            'with np.errstate(divide="ignore", invalid="ignore"):\n'
+            '    held_novelty = d_held / np.median(d_train)\n'),
+    },
+    2: {
+        'the data meshes\' latent path of section 3': 'gen_distortion = imp.edge_distortion["latent (ours)"].copy()\n',
+        'the default seed': (
+            'zg = model.sample_latent(2)\n'
+            '_, gen_path = itp.LatentPath(model.decode_latent, zg[0], zg[1]).steps(N_STEPS)\n'
+            'gen_distortion, _ = itp.edge_length_distortion(gen_path, coll.faces, train)\n'),
+        'against the held-out meshes': _GEN_PATH + 'gen_distortion, _ = itp.edge_length_distortion(gen_path, coll.faces, held)\n',
+    },
+    3: {
+        'a training mesh\'s own code': _claimed('z_new = model.encode_meshes(train[:1], inference="encoder")[0]\n'),
+        'a draw scaled up to push the novelty': _claimed('z_new = 3 * model.sample_latent(1, seed=SEED + 1)[0]\n'),
+        'numbers copied from the printout onto another draw': (
+            'z_new = model.sample_latent(1, seed=SEED)[0]\n'
+            'new_novelty, new_stretch = 1.91, 1.36 * float(np.median(stretch_held))\n'),
+    },
 }
