@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from meshvae_lib.viewing.embedding_maps import embedding_maps_figure
-from meshvae_lib.viewing.prior_costs import one_dimension_cost, prior_cost_figure
+from meshvae_lib.course.prior_costs import one_dimension_cost, prior_cost_figure
 
 
 def _maps(n=30):
