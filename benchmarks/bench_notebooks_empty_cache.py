@@ -26,6 +26,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 BUDGET_S = 300.0   # issue 36: at most 5 minutes per notebook on 2 cores, or the cost is stated
+CELL_TIMEOUT_S = 7200   # a cell that trains course models runs for many minutes; Jupyter itself sets no limit
 
 
 def _cached(cache: Path) -> set[str]:
@@ -41,7 +42,8 @@ def run(notebooks: list[Path], each_cold: bool) -> list[dict]:
             before = _cached(cache)
             env = {**os.environ, "MESHVAE_CACHE": str(cache)}
             start = time.perf_counter()
-            done = subprocess.run([sys.executable, "-m", "meshvae_lib.course", "execute", str(nb), "--out", out],
+            done = subprocess.run([sys.executable, "-m", "meshvae_lib.course", "execute", str(nb), "--out", out,
+                                   "--timeout", str(CELL_TIMEOUT_S)],
                                   cwd=ROOT, env=env, capture_output=True, text=True)
             seconds = time.perf_counter() - start
             trained = sorted(_cached(cache) - before)
