@@ -1,5 +1,7 @@
 """train_vae: loss goes down, runs repeat exactly, history and held-out parts, sigma_object."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -325,3 +327,26 @@ def test_the_default_latent_size_covers_every_direction_of_a_pca_start():
     assert residual["auto"] < 2e-4 < 0.005 < residual["128"], residual
     res = train_vae(X, config=TrainConfig(epochs=1, progress=False, early_stopping=False))
     assert res.model.latent_dim == 149 and res.model.input_rank == 149
+
+
+def test_a_start_whose_span_holds_every_row_is_kept_without_the_epoch_search():
+    from meshvae_lib.model.training import START_IS_OPTIMUM, start_is_optimum
+
+    X = _in_range(n=24)
+    assert start_is_optimum(TrainConfig(), 24, 0)                       # latent 128 >= 23 rows' rank
+    assert start_is_optimum(TrainConfig(latent_dim=23), 24, 0) and not start_is_optimum(TrainConfig(latent_dim=22), 24, 0)
+    assert not start_is_optimum(TrainConfig(early_stopping=True), 24, 0)      # asked for: the search runs
+    assert not start_is_optimum(TrainConfig(hidden=(8,)), 24, 0)             # internal layers can move
+    assert not start_is_optimum(TrainConfig(sigma_object=(0.5,)), 24, 0)     # a sigma_object prior
+    assert not start_is_optimum(TrainConfig(), 24, 3)                       # labels
+    assert not start_is_optimum(TrainConfig(init="random"), 24, 0)          # the paper's random start
+    cfg = TrainConfig(epochs=30, progress=False, eval_every=5, patience=10)
+    res = train_vae(X, config=cfg)
+    assert res.epochs == 0 and res.selection == {"epochs": 0, "skipped": START_IS_OPTIMUM}
+    assert len(res.history) == 1 and res.history[0]["epoch"] == 0
+    init = MeshVAE.from_pca(torch.from_numpy(X.astype(np.float32)), replace(cfg, latent_dim=128))
+    assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), init.state_dict().values()))
+    # the search, forced, runs and keeps the same start here (the rows are reproduced: nothing to lower)
+    searched = train_vae(X, config=replace(cfg, early_stopping=True))
+    assert "history" in searched.selection and searched.epochs == 0
+    assert all(torch.equal(a, b) for a, b in zip(res.model.state_dict().values(), searched.model.state_dict().values()))

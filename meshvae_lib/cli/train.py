@@ -200,7 +200,9 @@ def run(args) -> int:
         raise UsageError(_option_names(str(exc))) from exc
     model.save(args.output)
     last = model.history_[-1]
-    if model.selection_ is not None:
+    if model.selection_ is not None and "skipped" in model.selection_:
+        result(f"no epoch search, the model is the PCA start: {model.selection_['skipped']}")
+    elif model.selection_ is not None:
         result(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"
                f" {model.train_epochs_} epochs" + (" (the PCA start itself)" if model.train_epochs_ == 0 else ""))
     result(f"trained in {model.train_seconds_:.1f} s: loss {last['total']:.4g} (reconstruction"

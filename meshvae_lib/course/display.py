@@ -116,7 +116,8 @@ def describe_model(model) -> dict:
     empty: one linear map each way), ``conditions`` (number of condition inputs), ``sigma_object``
     (True when a sigma_object prior was trained), ``start`` ("PCA" or "random"), ``epoch_budget``
     (the configured epochs), ``epochs`` (epochs the network was trained for), ``early_stopping``
-    (True when early stopping chose them), ``mse_first`` and ``mse_last`` (the training
+    (True when early stopping chose them), ``search_skipped`` (True when the start was kept
+    without a search, ``meshvae_lib.model.training.start_is_optimum``), ``mse_first`` and ``mse_last`` (the training
     reconstruction MSE of the first and the last history record; equal when not trained).
     """
     from meshvae_lib.validation import check_is_fitted
@@ -136,7 +137,8 @@ def describe_model(model) -> dict:
         "start": "PCA" if config.uses_pca_init(n_cond) else "random",
         "epoch_budget": int(config.epochs),
         "epochs": int(model.train_epochs_),
-        "early_stopping": model.selection_ is not None,
+        "early_stopping": model.selection_ is not None and "skipped" not in model.selection_,
+        "search_skipped": model.selection_ is not None and "skipped" in model.selection_,
         "mse_first": float(history[0]["mse"]),
         "mse_last": float(history[-1]["mse"]),
     }
@@ -151,7 +153,8 @@ def model_summary(model) -> str:
         "internal layers " + " -> ".join(str(h) for h in d["hidden"])
     extras = [f"{d['conditions']} condition inputs"] * bool(d["conditions"]) + ["a sigma_object prior"] * d["sigma_object"]
     start = "the PCA of the training features" if d["start"] == "PCA" else "random weights (PyTorch's initialisation)"
-    chosen = "chosen by early stopping" if d["early_stopping"] else "a fixed budget"
+    chosen = ("no epoch search: the start's span holds every training row" if d["search_skipped"] else
+              "chosen by early stopping" if d["early_stopping"] else "a fixed budget")
     if d["epochs"] == 0:
         trained = f"0 of {d['epoch_budget']} epochs ({chosen}): the model is its start"
     else:

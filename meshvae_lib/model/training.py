@@ -29,7 +29,7 @@ from meshvae_lib.model.vae import vae_loss
 from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.validation import check_count, check_finite, check_rows
 
-__all__ = ["TrainResult", "TrainingDiverged", "train_vae", "holdout_mask", "resolve_device", "to_output_range",
+__all__ = ["TrainResult", "TrainingDiverged", "train_vae", "start_is_optimum", "START_IS_OPTIMUM", "holdout_mask", "resolve_device", "to_output_range",
            "from_output_range"]
 
 logger = logging.getLogger(__name__)
@@ -54,7 +54,8 @@ class TrainResult:
     device : where it trained.
     epochs : epochs the returned network was trained for.
     selection : early stopping's record, or None when it was off: ``{"epochs": best,
-        "validation_rows": [...], "history": [{"epoch", "val_mse"}, ...]}``.
+        "validation_rows": [...], "history": [{"epoch", "val_mse"}, ...]}``; when the start is
+        already the network's optimum (:func:`start_is_optimum`) ``{"epochs": 0, "skipped": why}``.
     """
 
     model: Network
@@ -292,6 +293,21 @@ def _select(x, c, n_cond: int, loss: _Loss, device) -> tuple[int, dict]:
     return epochs, {"epochs": int(epochs), "validation_rows": [int(i) for i in val_i], "history": history}
 
 
+#: Why :func:`train_vae` keeps a PCA start untrained (``TrainResult.selection["skipped"]``).
+START_IS_OPTIMUM = ("the PCA start's span holds every training row (latent size >= rows - 1), so its decoder"
+                    " reproduces them all and a network without internal layers has nothing left to lower;"
+                    " early stopping chose 0 epochs here on every real collection measured (issue 38)")
+
+
+def start_is_optimum(config: TrainConfig, n_rows: int, n_conditions: int) -> bool:
+    """True when a new network's start cannot be improved by training, so early stopping's search is
+    skipped: the PCA start (no internal layer, the standard prior, no labels, a tanh output), early
+    stopping left to its default (``config.early_stopping is None``; True asks for the search) and a
+    latent size (resolved) of at least ``n_rows - 1``, the rank of the centred rows."""
+    return (config.early_stopping is None and config.uses_pca_init(n_conditions)
+            and config.resolved_latent_dim(n_rows, n_conditions) >= n_rows - 1)
+
+
 def train_vae(
     features,
     conditions=None,
@@ -337,7 +353,10 @@ def train_vae(
 
     t0 = time.perf_counter()
     epochs, selection = config.epochs, None
-    if early:
+    if early and start_is_optimum(config, n, n_cond):
+        epochs, selection = 0, {"epochs": 0, "skipped": START_IS_OPTIMUM}
+        logger.info("no epoch search: %s", START_IS_OPTIMUM)
+    elif early:
         epochs, selection = _select(x, c, n_cond, loss, device)
     if model is None:
         model = _new_network(x, n_cond, config)
