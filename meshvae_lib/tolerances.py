@@ -140,7 +140,11 @@ RECALL_RANK_SLACK = 1e-9
 TIE_RTOL = 1e-9
 
 # --- latent inference by Gauss-Newton (model.inference, issue 23) -------------------------------
-#: geometry.sparse_lu.solve_columns: right-hand sides per SuperLU solve (it slows beyond ~16).
+#: geometry.reconstruction_linearization: directions pushed through the linearised reconstruction
+#: together. Per-edge intermediates of 32 columns (10k vertices: 23 MB) stay below the allocator's
+#: reuse threshold; all 139 at once were 25 % slower on samba (issue 38).
+JVP_BLOCK = 32
+#: geometry.spd_factor: right-hand sides per SuperLU solve, the fallback without cholespy (it slows beyond ~16).
 SPARSE_SOLVE_CHUNK = 12
 #: Levenberg-Marquardt damping of the Gauss-Newton inference, as a fraction of each diagonal entry of
 #: J^T J (Marquardt's scaling): where it starts, how it grows on a rejected step and shrinks on an

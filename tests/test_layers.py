@@ -15,7 +15,7 @@ import pytest
 
 LIB = Path(__file__).resolve().parents[1] / "meshvae_lib"
 
-BASE = {"tolerances", "defaults", "validation", "input_checks", "progress", "atomic", "__init__", "__version__"}
+BASE = {"tolerances", "defaults", "validation", "input_checks", "progress", "atomic", "workers", "__init__", "__version__"}
 #: layer -> the layers its modules may import from (its own included)
 ALLOWED = {
     "base": {"base"},

@@ -37,7 +37,7 @@ from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.geometry.deformation_gradient import DeformationGradientOperator
 from meshvae_lib.geometry.polar import polar_rs_soa
 from meshvae_lib.geometry.rotations import exp_soa, matmul_soa
-from meshvae_lib.geometry.sparse_lu import factorize_spd, pinning, solve_columns
+from meshvae_lib.geometry.spd_factor import factorize_spd, pinning
 from meshvae_lib.geometry.topology import edge_index
 
 __all__ = ["eq1_system", "gradient_columns", "PaperPositionSolver", "ExactPositionSolver"]
@@ -118,13 +118,13 @@ class _PinnedSolve:
         -> positions ``(n, 3, d)`` float64. Linear in ``dT``: the derivative of the positions."""
         n, _, d = dT.shape
         tcols = dT.reshape(n, 3, 3, d).transpose(0, 2, 1, 3).reshape(3 * n, 3 * d)
-        return solve_columns(self._pos_lu, self._rhs_op @ tcols).reshape(n, 3, d)
+        return self._pos_lu.solve(self._rhs_op @ tcols).reshape(n, 3, d)
 
     def solve_gradients_adjoint(self, dP: np.ndarray) -> np.ndarray:
         """The transpose of :meth:`solve_gradients`: ``dP (n, 3, d) -> (n, 9, d)`` float64 (the
         pinned system is symmetric, so its factorisation serves the adjoint)."""
         n, _, d = dP.shape
-        lam = solve_columns(self._pos_lu, dP.reshape(n, 3 * d))
+        lam = self._pos_lu.solve(dP.reshape(n, 3 * d))
         t = (self._rhs_op.T @ lam).reshape(n, 3, 3, d)
         return t.transpose(0, 2, 1, 3).reshape(n, 9, d)
 

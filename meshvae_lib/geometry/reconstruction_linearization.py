@@ -24,7 +24,8 @@ derivative. For a perturbation ``df`` of the feature:
    position solve of ``dT`` -- again a fixed, factorised matrix.
 
 So a Jacobian-vector product costs one sparse solve per synchronisation sweep taken (0 to 3) plus
-one position solve, all with already-factorised matrices, and the adjoint the same solves in
+one position solve, all with already-factorised matrices; many directions go through together, in
+blocks of ``JVP_BLOCK`` columns (multi-column solves, and intermediates small enough to stay cached), and the adjoint the same solves in
 reverse order (the matrices are symmetric). Matches central differences of the reconstruction to
 the differences' own accuracy (``tests/test_inference.py``). Not differentiated: the exact solver's
 optional Gauss-Newton refinement (active only for meshes with perfectly symmetric one-rings,
@@ -38,6 +39,7 @@ import numpy as np
 
 from meshvae_lib.geometry.rimd import S_ENTRIES
 from meshvae_lib.geometry.rotations import matmul_soa, right_jacobian
+from meshvae_lib.tolerances import JVP_BLOCK
 
 __all__ = ["ReconstructionLinearization"]
 
@@ -127,10 +129,14 @@ class ReconstructionLinearization:
         dF = dF[:, None] if single else dF
         if dF.ndim != 2 or dF.shape[0] != self.n_features:
             raise ValueError(f"dF must have shape ({self.n_features},) or ({self.n_features}, d), got {dF.shape}")
-        dw, dS6 = self._split(dF)
-        g = self._rotations.linear_response(self._record, self._edge_map @ dw)   # (n, 3, d)
-        dT = self._g_map @ g + self._s_map @ dS6                          # (n, 9, d)
-        dP = self._positions_solver.solve_gradients(dT)                   # (n, 3, d)
+        d = dF.shape[1]
+        dP = np.empty((self._layout.n_vertices, 3, d))
+        for k in range(0, d, JVP_BLOCK):     # blocks of columns: the intermediates stay small
+            dw, dS6 = self._split(dF[:, k:k + JVP_BLOCK])
+            g = self._rotations.linear_response(self._record, self._edge_map @ dw)   # (n, 3, b)
+            dT = self._g_map @ g
+            dT += self._s_map @ dS6                                           # (n, 9, b)
+            dP[:, :, k:k + JVP_BLOCK] = self._positions_solver.solve_gradients(dT)
         return dP[:, :, 0] if single else dP
 
     def vjp(self, dP) -> np.ndarray:

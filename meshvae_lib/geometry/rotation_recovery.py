@@ -29,7 +29,7 @@ from meshvae_lib import tolerances as tol
 from meshvae_lib.defaults import ROTATION_RECOVERY
 from meshvae_lib.geometry.rotations import (
     exp_soa, matmul_soa, quat_exp_soa, quat_from_soa, quat_mul_soa, right_jacobian)
-from meshvae_lib.geometry.sparse_lu import factorize_spd, pinning, solve_columns
+from meshvae_lib.geometry.spd_factor import factorize_spd, pinning
 from meshvae_lib.geometry.topology import edge_index
 from meshvae_lib.validation import check_choice
 
@@ -237,6 +237,28 @@ class RotationRecovery:
         tr = np.trace(D, axis1=1, axis2=2)[:, None, None] * np.eye(3)
         return Rm, 0.5 * (tr - D), 0.5 * (tr - D.transpose(0, 2, 1))
 
+    def _response_terms(self, record: dict) -> dict:
+        """What :meth:`linear_response` and its adjoint need of a record that does not depend on the
+        directions pushed through (computed once per record and kept in it under ``"terms"``): the
+        walk's ``c_child = B_child eta_u`` maps, and per sweep ``M_l``, ``M_r``, ``M_r R_j``, ``J_l(omega)``
+        and ``exp(hat(omega))``, all as (m, 3, 3) stacks."""
+        terms = record.get("terms")
+        if terms is not None:
+            return terms
+        n = self.n_vertices
+        Rb = np.ascontiguousarray(record["bfs"].T).reshape(n, 3, 3)
+        child = np.flatnonzero(self._parent >= 0)
+        u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
+        walk = np.where(flip[:, None, None], -Rb[par], Rb[child])
+        steps = []
+        for R, omega in record["steps"]:
+            Rm, Ml, Mr = self._edge_terms(R, record["w"])
+            Ex = np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3)
+            steps.append({"Ml": Ml, "Mr": Mr, "MrR": Mr @ Rm[self.edges[:, 1]], "Rj": Rm[self.edges[:, 1]],
+                          "Jl": right_jacobian(-omega), "Ex": Ex})
+        terms = record["terms"] = {"child": child, "u": u, "walk": walk, "steps": steps}
+        return terms
+
     def linear_response(self, record: dict, eta: np.ndarray) -> np.ndarray:
         """Global-frame changes ``g`` of the recovered rotations (``R_i <- exp(hat(g_i)) R_i``) for
         body-frame changes ``eta`` of the edge rotations (``dR_ij <- dR_ij exp(hat(eta_ij))``),
@@ -244,7 +266,8 @@ class RotationRecovery:
         (``- R_parent eta`` for edges walked against their order), then each sweep: the residual
         ``delta_ij = vee(skew(R_i dR_ij R_j^T))`` changes by ``M_l g_i + M_r (R_j eta_ij - g_j)``, the
         correction ``omega = L^-1 G^T delta`` by ``L^-1 G^T d(delta)`` (the factorised Laplacian) and
-        ``exp(hat(omega)) R`` by ``g <- J_l(omega) d(omega) + exp(hat(omega)) g``.
+        ``exp(hat(omega)) R`` by ``g <- J_l(omega) d(omega) + exp(hat(omega)) g``. All ``d`` directions
+        go through together: one multi-column solve per sweep.
 
         Parameters
         ----------
@@ -256,20 +279,19 @@ class RotationRecovery:
         g : (n_vertices, 3, d) float64
         """
         n, (E, _, d) = self.n_vertices, eta.shape
-        Rb = np.ascontiguousarray(record["bfs"].T).reshape(n, 3, 3)
-        child = np.flatnonzero(self._parent >= 0)
-        u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
-        c = np.zeros((n, 3, d))
-        c[child] = np.where(flip[:, None, None], -(Rb[par] @ eta[u]), Rb[child] @ eta[u])
+        terms = self._response_terms(record)
         g = np.zeros((n, 3, d))
+        g[terms["child"]] = terms["walk"] @ eta[terms["u"]]
         for lv in self._levels[1:]:
-            g[lv] = g[self._parent[lv]] + c[lv]
+            g[lv] += g[self._parent[lv]]
         E0, E1 = self.edges[:, 0], self.edges[:, 1]
-        for R, omega in record["steps"]:
-            Rm, Ml, Mr = self._edge_terms(R, record["w"])
-            dd = Ml @ g[E0] + Mr @ (Rm[E1] @ eta - g[E1])
-            dw = solve_columns(self._sync_lu, self._Gt @ dd.reshape(E, 3 * d)).reshape(n, 3, d)
-            g = right_jacobian(-omega) @ dw + np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3) @ g
+        for st in terms["steps"]:
+            dd = st["Ml"] @ g[E0]
+            dd -= st["Mr"] @ g[E1]
+            dd += st["MrR"] @ eta
+            dw = self._sync_lu.solve(self._Gt @ dd.reshape(E, 3 * d)).reshape(n, 3, d)
+            g = st["Ex"] @ g
+            g += st["Jl"] @ dw
         return g
 
     def linear_response_adjoint(self, record: dict, g_adj: np.ndarray) -> np.ndarray:
@@ -277,25 +299,19 @@ class RotationRecovery:
         n, d = self.n_vertices, g_adj.shape[2]
         E = len(self.edges)
         E0, E1 = self.edges[:, 0], self.edges[:, 1]
+        terms = self._response_terms(record)
         eta_adj = np.zeros((E, 3, d))
         g = np.array(g_adj, dtype=np.float64)
-        for R, omega in reversed(record["steps"]):
-            Rm, Ml, Mr = self._edge_terms(R, record["w"])
-            Ex = np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3)
-            dw_adj = right_jacobian(-omega).transpose(0, 2, 1) @ g
-            g = Ex.transpose(0, 2, 1) @ g
-            b = solve_columns(self._sync_lu, dw_adj.reshape(n, 3 * d))     # the Laplacian is symmetric
+        for st in reversed(terms["steps"]):
+            dw_adj = st["Jl"].transpose(0, 2, 1) @ g
+            g = st["Ex"].transpose(0, 2, 1) @ g
+            b = self._sync_lu.solve(dw_adj.reshape(n, 3 * d))     # the Laplacian is symmetric
             dd_adj = (self._G @ b).reshape(E, 3, d)
-            np.add.at(g, E0, Ml.transpose(0, 2, 1) @ dd_adj)
-            r_adj = Mr.transpose(0, 2, 1) @ dd_adj
+            np.add.at(g, E0, st["Ml"].transpose(0, 2, 1) @ dd_adj)
+            r_adj = st["Mr"].transpose(0, 2, 1) @ dd_adj
             np.add.at(g, E1, -r_adj)
-            eta_adj += Rm[E1].transpose(0, 2, 1) @ r_adj
-        Rb = np.ascontiguousarray(record["bfs"].T).reshape(n, 3, 3)
+            eta_adj += st["Rj"].transpose(0, 2, 1) @ r_adj
         for lv in reversed(self._levels[1:]):
             np.add.at(g, self._parent[lv], g[lv])
-        child = np.flatnonzero(self._parent >= 0)
-        u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
-        contrib = np.where(flip[:, None, None], -(Rb[par].transpose(0, 2, 1) @ g[child]),
-                           Rb[child].transpose(0, 2, 1) @ g[child])
-        np.add.at(eta_adj, u, contrib)
+        np.add.at(eta_adj, terms["u"], terms["walk"].transpose(0, 2, 1) @ g[terms["child"]])
         return eta_adj
