@@ -10,6 +10,13 @@ Jacobian) and, with ``--finite-difference``, the old forward-difference fit. Med
     python benchmarks/bench_inference.py --model /tmp/models/samba_rimd.pt --real samba
     python benchmarks/bench_inference.py --real samba --subsample 3  # trains the default model first
     python benchmarks/bench_inference.py --synth scape            # without the real data
+    python benchmarks/bench_inference.py --real samba --jobs 1 2 --solvers   # issue 38's measurements
+
+``--jobs 1 2`` also times ``encode_meshes`` of all ``--meshes`` meshes at once with that many worker
+processes (seconds per mesh = total / meshes: the throughput of ``evaluate``). ``--solvers`` times
+the sparse solves of one Jacobian alone: the synchronisation and position systems with three
+right-hand sides per used dimension, by SuperLU (in chunks of 12, and all at once) and by CHOLMOD
+(``cholespy``, the library's choice): the floor of one Jacobian.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import numpy as np
 import torch
 
 from feature_comparison import load_real
+from meshvae_lib.model.inference.gauss_newton import GaussNewton
 from meshvae_lib.model.meshvae_model import load_model
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
@@ -37,6 +45,8 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--finite-difference", action="store_true", help="also time the forward-difference fit (slow)")
+    ap.add_argument("--jobs", type=int, nargs="*", default=[], help="also time all meshes at once with these worker counts")
+    ap.add_argument("--solvers", action="store_true", help="also time one Jacobian's sparse solves alone")
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
     if args.model:
@@ -68,6 +78,42 @@ def main() -> None:
         extra = f", {model.last_inference_!r}" if method == "gauss-newton" else ""
         print(f"{method:18s} {statistics.median(times):8.3f} s  (min {min(times):.3f}, max {max(times):.3f}){extra}",
               flush=True)
+    for jobs in args.jobs:
+        times = []
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            Z = model.encode_meshes(V, inference=GaussNewton(n_jobs=jobs))
+            times.append((time.perf_counter() - t0) / len(V))
+        print(f"all {len(V)} meshes, {jobs} process(es): {statistics.median(times):.3f} s per mesh (min {min(times):.3f},"
+              f" max {max(times):.3f}), mean error {model.last_inference_.final_error.mean():.6g}", flush=True)
+    if args.solvers:
+        solver_floor(model, args.repeats)
+
+
+def solver_floor(model, repeats: int) -> None:
+    """The sparse solves of one Jacobian alone, by each solver (see the module docstring)."""
+    from meshvae_lib.geometry.spd_factor import SPDFactor
+
+    rec = model.feature_kind.reconstructor
+    rr, ps = rec.rotation_recovery, rec.position_solver
+    n = rr.n_vertices
+    systems = {"synchronisation": rr.system_matrix(), "position": ps.system_matrix()}
+    cols = 3 * len(model.used_latent_dims)
+    B = np.random.default_rng(0).standard_normal((n, cols))
+    print(f"one Jacobian's solves, {cols} right-hand sides ({len(model.used_latent_dims)} used dimensions x 3),"
+          f" median of {repeats}:")
+    for name, M in systems.items():
+        row = []
+        for label, factor in (("SuperLU chunks of 12", SPDFactor(M, "superlu", chunk=12)),
+                              ("SuperLU all at once", SPDFactor(M, "superlu", chunk=None)),
+                              ("CHOLMOD all at once", SPDFactor(M, "cholmod"))):
+            times = []
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                factor.solve(B)
+                times.append(time.perf_counter() - t0)
+            row.append(f"{label} {statistics.median(times):.3f} s")
+        print(f"  {name:16s} " + ", ".join(row), flush=True)
 
 
 if __name__ == "__main__":

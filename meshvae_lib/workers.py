@@ -42,6 +42,15 @@ def resolve_jobs(n_jobs: int | None, n_items: int) -> int:
     return max(1, min(jobs, n_items))
 
 
+def _one_thread() -> None:
+    """Worker initialiser: one BLAS and one torch thread per worker (the workers fill the cores)."""
+    from threadpoolctl import threadpool_limits
+    import torch
+
+    threadpool_limits(1)
+    torch.set_num_threads(1)
+
+
 def _run(i: int):
     return i, _TASK(i)
 
@@ -73,7 +82,7 @@ def map_forked(task: Callable[[int], Any], n_items: int, n_jobs: int | None = No
         return results
     _TASK = task
     try:
-        with mp.get_context("fork").Pool(jobs) as pool:
+        with mp.get_context("fork").Pool(jobs, initializer=_one_thread) as pool:
             for i, r in pool.imap_unordered(_run, range(n_items)):
                 results[i] = r
                 if on_result is not None:

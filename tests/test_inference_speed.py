@@ -118,3 +118,53 @@ def test_meshes_fitted_in_worker_processes_equal_the_serial_fit_exactly(bent):
     assert np.all(rep1.final_error < rep1.initial_error)     # the fit did something worth comparing
     # the strategy's option reaches the fit
     np.testing.assert_array_equal(model.encode_meshes(V, inference=GaussNewton(iterations=3, n_jobs=2)), serial)
+
+
+def test_chord_steps_only_lower_the_error_and_zero_keeps_the_plain_method(bent):
+    from meshvae_lib.model.inference.least_squares import marquardt_fit
+
+    model = MeshVAEModel("rimd", TrainConfig(progress=False, latent_dim=6, seed=0), holdout_every=3).fit(bent)
+    V = bent.vertices[model.holdout_mask_]
+    z0 = model.encode_meshes(V, inference="encoder")
+    plain, _ = gauss_newton_codes(model, V, z0, iterations=2, n_jobs=1)
+    zero, _ = gauss_newton_codes(model, V, z0, iterations=2, n_jobs=1, chord_steps=0)
+    np.testing.assert_array_equal(zero, plain)
+    # after one Jacobian both take the same step; chord steps after it are kept only when they lower
+    # the squared error (a nonlinear toy problem: the squares of the parameters, then a linear map)
+    A = np.random.default_rng(1).standard_normal((30, 4))
+    target = A @ (np.array([0.8, 1.2, 0.5, 1.5]) ** 2)
+
+    class Squares:
+        def __init__(self, u):
+            self.residual = (target - A @ u ** 2).reshape(10, 3)
+            self.sq_error = float(self.residual.ravel() @ self.residual.ravel())
+
+    states = {}
+
+    def state_at(u):
+        st = Squares(u)
+        states[id(st)] = u.copy()
+        return st
+
+    def jacobian_at(state):
+        return A * (2 * states[id(state)])
+
+    u0 = np.ones(4)
+    plain_fit = marquardt_fit(u0, state_at, jacobian_at, iterations=1)
+    chord_fit = marquardt_fit(u0, state_at, jacobian_at, iterations=1, chord_steps=3)
+    assert chord_fit.jacobians == plain_fit.jacobians == 1 and chord_fit.decodes > plain_fit.decodes
+    assert chord_fit.state.sq_error < 0.5 * plain_fit.state.sq_error < 0.5 * plain_fit.start.sq_error
+    assert GaussNewton(iterations=3, chord_steps=1).describe() == "encoder + Gauss-Newton, 3 steps (+1 chord each)"
+    # on a linear problem the first Gauss-Newton step is exact: chord steps find nothing to add
+    A = np.random.default_rng(0).standard_normal((30, 4))
+    b = A @ np.array([1.0, -2.0, 0.5, 3.0])
+
+    class Linear:
+        def __init__(self, u):
+            self.residual = (b - A @ u).reshape(10, 3)
+            self.sq_error = float(self.residual.ravel() @ self.residual.ravel())
+
+    fit = marquardt_fit(np.zeros(4), Linear, lambda state: A, iterations=1, chord_steps=3)
+    np.testing.assert_allclose(fit.u, [1.0, -2.0, 0.5, 3.0], atol=1e-2)
+    with pytest.raises(ValueError, match="chord_steps"):
+        marquardt_fit(np.zeros(4), Linear, lambda state: A, iterations=1, chord_steps=-1)

@@ -106,8 +106,13 @@ class _PinnedSolve:
 
     def __init__(self, A: sp.spmatrix, rhs: sp.csr_matrix, roots: np.ndarray):
         scale = float(A.diagonal().mean())
-        self._pos_lu = factorize_spd(A + pinning(A.shape[0], roots, scale))
+        self._system = (A + pinning(A.shape[0], roots, scale)).tocsr()
+        self._pos_lu = factorize_spd(self._system)
         self._rhs_op = rhs  # (n, 3n)
+
+    def system_matrix(self) -> sp.csr_matrix:
+        """The pinned position system ``(n, n)`` float64 that is factorised (for benchmarks)."""
+        return self._system
 
     def linear_solve(self, tcols: np.ndarray) -> np.ndarray:
         """Positions ``(n, 3)`` for gradients in the layout of :func:`gradient_columns`."""

@@ -129,7 +129,12 @@ class RotationRecovery:
         )
         self._G = G
         self._Gt = G.T.tocsr()
-        self._sync_lu = factorize_spd(G.T @ G + pinning(n, self.roots, 1.0))
+        self._sync_system = (G.T @ G + pinning(n, self.roots, 1.0)).tocsr()
+        self._sync_lu = factorize_spd(self._sync_system)
+
+    def system_matrix(self) -> sp.csr_matrix:
+        """The pinned synchronisation Laplacian ``(n, n)`` float64 that is factorised (for benchmarks)."""
+        return self._sync_system
 
     def bfs(self, w: np.ndarray) -> np.ndarray:
         """Walk the spanning tree: ``R_child = R_parent dR_parent,child``.

@@ -45,6 +45,8 @@ class SPDFactor:
     ----------
     M : scipy.sparse matrix, shape (n, n), float64, symmetric positive definite.
     backend : {"cholmod", "superlu"} or None (None: :func:`spd_backend`).
+    chunk : int or None
+        SuperLU only: right-hand sides per solve (None: all at once).
 
     Attributes
     ----------
@@ -52,7 +54,8 @@ class SPDFactor:
     shape : (n, n)
     """
 
-    def __init__(self, M: sp.spmatrix, backend: str | None = None):
+    def __init__(self, M: sp.spmatrix, backend: str | None = None, chunk: int | None = SPARSE_SOLVE_CHUNK):
+        self.chunk = chunk
         self.backend = spd_backend() if backend is None else backend
         if self.backend not in ("cholmod", "superlu"):
             raise ValueError(f"backend must be 'cholmod' or 'superlu', got {backend!r}")
@@ -81,10 +84,10 @@ class SPDFactor:
             X = np.empty_like(B)
             self._solver.solve(B, X)
             return X
-        if B.ndim == 1 or B.shape[1] <= SPARSE_SOLVE_CHUNK:
+        if B.ndim == 1 or self.chunk is None or B.shape[1] <= self.chunk:
             return self._solver.solve(B)
-        return np.concatenate([self._solver.solve(np.ascontiguousarray(B[:, k:k + SPARSE_SOLVE_CHUNK]))
-                               for k in range(0, B.shape[1], SPARSE_SOLVE_CHUNK)], axis=1)
+        return np.concatenate([self._solver.solve(np.ascontiguousarray(B[:, k:k + self.chunk]))
+                               for k in range(0, B.shape[1], self.chunk)], axis=1)
 
 
 def factorize_spd(M: sp.spmatrix, backend: str | None = None) -> SPDFactor:
