@@ -26,7 +26,7 @@ import torch
 
 from feature_comparison import load_real
 from meshvae_lib import tolerances as tol
-from meshvae_lib.model.inference.gauss_newton import _Decoder, gauss_newton_codes
+from meshvae_lib.model.inference.gauss_newton import LatentDecoder, gauss_newton_codes
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 
@@ -87,7 +87,7 @@ def main() -> None:
         raise SystemExit("this benchmark reads the default network (no hidden layer)")
     V = np.asarray(coll.vertices, dtype=np.float64)
     Vh, Vt = V[model.holdout_mask_][: args.meshes], V[~model.holdout_mask_]
-    decoder = _Decoder(model, None)
+    decoder = LatentDecoder(model, None)
     mu_t, _ = model.encode_rows(model.features_of(Vt), None)
     t0 = time.perf_counter()
     picks = np.linspace(0, len(Vt) - 1, args.metric_meshes).round().astype(int)

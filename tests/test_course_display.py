@@ -116,13 +116,21 @@ def test_model_summary_says_the_start_the_epochs_and_what_training_changed():
     assert (d["start"], d["hidden"], d["latent_dim"]) == ("random", (8,), 2)
     assert "internal layers 8" in model_summary(rand) and "random weights" in model_summary(rand)
 
-    chosen = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=4).fit(_strips(40))
+    # latent 8 below the 29 training rows' rank: the PCA start can move, early stopping searches
+    chosen = MeshVAEModel("rimd", TrainConfig(progress=False, latent_dim=8), holdout_every=4).fit(_strips(40))
     d = describe_model(chosen)
-    assert d["early_stopping"] and d["epochs"] == len(chosen.history_) - (d["epochs"] == 0) == chosen.train_epochs_
+    assert d["early_stopping"] and not d["search_skipped"]
+    assert d["epochs"] == len(chosen.history_) - (d["epochs"] == 0) == chosen.train_epochs_
     if d["epochs"] == 0:
         assert d["mse_first"] == d["mse_last"] and "(chosen by early stopping): the model is its start" in model_summary(chosen)
     else:
         assert f"{d['epochs']} of 1000 epochs (chosen by early stopping)" in model_summary(chosen)
+    # the default latent size holds every training row: the start is kept without a search
+    kept = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=4).fit(_strips(40))
+    d = describe_model(kept)
+    assert d["search_skipped"] and not d["early_stopping"] and d["epochs"] == 0 and d["mse_first"] == d["mse_last"]
+    assert "0 of 1000 epochs (no epoch search: the start's span holds every training row): the model is its start" \
+        in model_summary(kept)
 
 
 def test_model_summary_refuses_an_unfitted_model():

@@ -9,7 +9,10 @@ name (the network's ``architecture`` attribute, recorded in checkpoints) to its 
 
 To add an architecture: write a module with a class that follows :class:`Network` and add one
 line to :data:`ARCHITECTURES`; ``TrainConfig(architecture=...)`` trains it, and the checkpoint
-stores and rebuilds it by name.
+stores and rebuilds it by name. Every inference works on it unchanged: the decoder's linearisation
+(:func:`decoder_linearization`) comes from autograd unless the class has a closed form of its own
+(``decoder_jacobian``), and a decoder that is one linear map and an activation can say so
+(``linear_decoder``) for the Gauss-Newton inference's fast path.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
     import torch
 
-__all__ = ["Network", "ARCHITECTURES", "network_class", "start_network", "network_from_config"]
+__all__ = ["Network", "ARCHITECTURES", "network_class", "start_network", "network_from_config", "decoder_linearization"]
 
 #: architecture name -> "module:Class" of a network that follows :class:`Network`.
 ARCHITECTURES = {
@@ -78,3 +81,37 @@ def start_network(architecture: str, x, n_conditions: int, config) -> Network:
 def network_from_config(architecture: str, config: dict) -> Network:
     """The network of ``architecture`` that ``config`` (its ``config()``) describes, weights untrained."""
     return network_class(architecture).from_config(dict(config))
+
+
+def decoder_linearization(network, z, c=None) -> "tuple[np.ndarray, np.ndarray]":
+    """A network's decoded rows at one code and their Jacobian with respect to it.
+
+    Parameters
+    ----------
+    network : a :class:`Network` in eval mode.
+    z : (D,) float
+    c : (C,) float or None (a conditional network's condition vector).
+
+    Returns
+    -------
+    rows : (K,) float64, ``network.decode(z, c)``.
+    J : (K, D) float64, ``d rows / d z``: the class's own ``decoder_jacobian(z, c)`` where it has one
+        (the mesh VAE's closed form), else forward-mode autograd (``torch.func.jacfwd``, one pass
+        per latent dimension) of ``decode``.
+    """
+    import numpy as np
+    import torch
+
+    if callable(getattr(type(network), "decoder_jacobian", None)):
+        return network.decoder_jacobian(z, c)
+    zt = torch.as_tensor(np.asarray(z, dtype=np.float32).reshape(network.latent_dim))
+    ct = None if c is None else torch.as_tensor(np.asarray(c, dtype=np.float32).reshape(1, -1))
+
+    def decode(v):
+        return network.decode(v[None], ct)[0]
+
+    with torch.no_grad():
+        rows = decode(zt)
+    J = torch.func.jacfwd(decode)(zt)
+    return rows.double().numpy(), J.detach().double().numpy()
+

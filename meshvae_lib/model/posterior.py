@@ -66,7 +66,7 @@ def decoder_column_norms(network, mu) -> np.ndarray:
     -------
     c : (N, D) float64 (or (D,) for one code)
     """
-    from meshvae_lib.model.inference.gauss_newton import decoder_jacobian
+    from meshvae_lib.model.networks import decoder_linearization as decoder_jacobian
 
     if network.n_conditions:
         raise ValueError("decoder_column_norms takes an unconditional network; this one has "

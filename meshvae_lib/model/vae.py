@@ -44,7 +44,7 @@ from torch import nn
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, OUTPUTS, PRIOR_FORMS, SIGMA_MAX
 from meshvae_lib.model.inplace_grad import Linear
 from meshvae_lib.model.pca_start import pca_start
-from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
+from meshvae_lib.tolerances import GN_UNUSED_DIM_RTOL, SIGMA_LOGIT_MIN
 
 __all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
 
@@ -212,12 +212,32 @@ class MeshVAE(nn.Module):
 
     def used_latent_dims(self) -> np.ndarray:
         """Indices (int64) of the latent dimensions the decoder reads: with no internal layer, those
-        whose column of the decoder's weight is not all zero (the PCA start leaves the others at
-        zero); with internal layers, all of them."""
+        whose column of the decoder's weight exceeds ``GN_UNUSED_DIM_RTOL`` of the largest column
+        (the PCA start leaves the others at exactly zero); with internal layers, all of them. The
+        library's one rule for used dimensions."""
         if self.hidden:
             return np.arange(self.latent_dim)
-        W = self.decoder_head.weight.detach()
-        return np.flatnonzero(W[:, : self.latent_dim].abs().sum(0).numpy() > 0)
+        size = self.decoder_head.weight.detach()[:, : self.latent_dim].abs().amax(dim=0).double().numpy()
+        return np.flatnonzero(size > GN_UNUSED_DIM_RTOL * size.max()) if size.max() > 0 else np.arange(0)
+
+    def linear_decoder(self) -> tuple[torch.Tensor, torch.Tensor] | None:
+        """``(W (K, D + C), b (K,))`` float32 when the decoder is ``act(W [z, c] + b)`` (no internal
+        layer), else None: the Gauss-Newton inference's fast path."""
+        if self.hidden:
+            return None
+        return self.decoder_head.weight.detach(), self.decoder_head.bias.detach()
+
+    def decoder_hidden(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
+        """The input of the decoder's output layer: the internal layers' output for ``z (B, D)``
+        [+ ``c (B, C)``], or ``[z, c]`` itself without internal layers."""
+        return self.decoder_body(self._with_condition(z, c, self.latent_dim, "latent vectors"))
+
+    def decoder_jacobian(self, z: np.ndarray, c: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Decoded rows ``(K,)`` and ``d rows / d z`` ``(K, D)``, float64, in closed form
+        (:func:`~meshvae_lib.model.vae_linearization.mesh_vae_decoder_jacobian`)."""
+        from meshvae_lib.model.vae_linearization import mesh_vae_decoder_jacobian
+
+        return mesh_vae_decoder_jacobian(self, z, c)
 
     def _with_condition(self, x: torch.Tensor, c, width: int, what: str) -> torch.Tensor:
         if x.ndim != 2 or x.shape[1] != width:
@@ -269,7 +289,7 @@ class MeshVAE(nn.Module):
     def decode(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
         """Probabilistic decoder's mean: z (B, D) [+ c (B, C)] -> features (B, K) in (-1, 1)
         (``output="sigmoid"``: in (0, 1))."""
-        h = self.decoder_body(self._with_condition(z, c, self.latent_dim, "latent vectors"))
+        h = self.decoder_hidden(z, c)
         if self.output == "sigmoid":
             return torch.sigmoid(self.decoder_head(h))
         return torch.tanh(self.decoder_head(h))

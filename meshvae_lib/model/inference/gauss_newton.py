@@ -10,9 +10,9 @@ encoder alone spends its code on feature directions that barely move the vertice
 
 The rigid motion is eliminated by projecting the six rigid vertex fields (three translations,
 three rotations about the centroid) out of the Jacobian and aligning the target to each decoded
-mesh; the model's decoder, normaliser and reconstruction are not changed. The analytic Jacobian
-reads the output layer of :class:`~meshvae_lib.model.vae.MeshVAE` (``decoder_head``, and
-``decoder_body`` with internal layers).
+mesh; the model's decoder, normaliser and reconstruction are not changed. The network's Jacobian
+comes through its public protocol (:mod:`~meshvae_lib.model.networks`): the mesh VAE's closed form,
+or autograd for any other registered network, so every network gets this inference.
 """
 
 from __future__ import annotations
@@ -20,68 +20,23 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from meshvae_lib import tolerances as tol
 from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference.base import InferenceStrategy
+from meshvae_lib.model.networks import decoder_linearization
+from meshvae_lib.model.vae_linearization import output_slope
 from meshvae_lib.model.inference.least_squares import (  # noqa: F401 (re-exported)
     FitState, MarquardtFit, marquardt_fit, rigid_fields, without_rigid_motions)
 from meshvae_lib.validation import check_count
 from meshvae_lib.workers import map_forked, resolve_jobs
 
 __all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "without_rigid_motions", "GaussNewtonReport",
-           "gauss_newton_codes", "marquardt_fit", "MarquardtFit", "FitState"]
-
-
-def _activate(network, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The output activation and its slope, in float64."""
-    if network.output == "sigmoid":
-        r = 0.5 * (1.0 + np.tanh(0.5 * y))          # the logistic function, without overflow far out
-        return r, r * (1.0 - r)
-    r = np.tanh(y)
-    return r, 1.0 - r * r
+           "gauss_newton_codes", "marquardt_fit", "MarquardtFit", "FitState", "LatentDecoder"]
 
 
 def decoder_jacobian(network, z: np.ndarray, c: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The network's decoded rows and their Jacobian with respect to the code.
-
-    Parameters
-    ----------
-    network : MeshVAE (in eval mode: batch normalisation is then affine)
-    z : (D,) float
-        One latent code.
-    c : (C,) float or None
-        Its condition vector (conditional networks).
-
-    Returns
-    -------
-    rows : (K,) float64
-        ``network.decode(z, c)`` (in the network's output range).
-    J : (K, D) float64
-        ``d rows / d z = act'(y) W dh/dz`` with ``y = W h + b`` the output layer and ``h`` its
-        input: ``[z, c]`` without hidden layers (closed form, float64), else the hidden layers'
-        output, whose small Jacobian comes from torch's autograd.
-    """
-    D = network.latent_dim
-    z = np.asarray(z, dtype=np.float64).reshape(D)
-    W = network.decoder_head.weight.detach().double().numpy()
-    b = network.decoder_head.bias.detach().double().numpy()
-    if not network.hidden:
-        y = W[:, :D] @ z + b
-        if network.n_conditions:
-            y = y + W[:, D:] @ np.asarray(c, dtype=np.float64).reshape(network.n_conditions)
-        rows, slope = _activate(network, y)
-        return rows, slope[:, None] * W[:, :D]
-    ct = None if c is None else torch.from_numpy(np.asarray(c, dtype=np.float32).reshape(1, -1))
-
-    def body(v):
-        return network.decoder_body(network._with_condition(v[None], ct, D, "latent vectors"))[0]
-
-    zt = torch.from_numpy(z.astype(np.float32))
-    with torch.no_grad():
-        h = body(zt).double().numpy()
-    Jh = torch.autograd.functional.jacobian(body, zt).double().numpy()     # (width, D)
-    rows, slope = _activate(network, W @ h + b)
-    return rows, slope[:, None] * (W @ Jh)
+    """The network's decoded rows ``(K,)`` and their Jacobian ``(K, D)`` float64 at one code
+    (:func:`meshvae_lib.model.networks.decoder_linearization`: the network's closed form, or autograd)."""
+    return decoder_linearization(network, z, c)
 
 
 class GaussNewtonReport:
@@ -108,8 +63,20 @@ class GaussNewtonReport:
                 f" -> {self.final_error.mean():.4g}, iterations {self.iterations.mean():.1f}/mesh)")
 
 
-class _Decoder:
-    """Codes -> features and their Jacobian for one model, with the network's weights converted once."""
+class LatentDecoder:
+    """Codes -> features and their Jacobian for one model, with the network's weights converted once.
+
+    A network whose decoder is one linear map and an activation (``linear_decoder()``, the default
+    mesh VAE) is evaluated here in float64 on its used columns only; any other through
+    :func:`decoder_jacobian` at every state.
+
+    Attributes
+    ----------
+    used : (n_used,) int64, the latent dimensions the decoder reads (``model.used_latent_dims``).
+    offset, scale : (K,) float64, features = offset + scale * network rows.
+    linear : bool, the fast path; then ``W (K, n_used)``, ``b (K,)`` and ``Wc (K, C)`` float64, the
+        output layer's used columns, bias and condition columns.
+    """
 
     def __init__(self, model, conditions: np.ndarray | None):
         net = model.network
@@ -118,38 +85,36 @@ class _Decoder:
         # rows -> features is affine per column (the output range, then Eq. 3 inverted)
         self.offset = np.asarray(model.features_from_rows(np.zeros((1, K))), dtype=np.float64)[0]
         self.scale = np.asarray(model.features_from_rows(np.ones((1, K))), dtype=np.float64)[0] - self.offset
-        if net.hidden:
-            self.used = np.arange(D)
+        self.used = np.asarray(model.used_latent_dims, dtype=np.int64)
+        linear = net.linear_decoder() if callable(getattr(net, "linear_decoder", None)) else None
+        self.linear = linear is not None
+        if not self.linear:
             return
         # the output layer's weights (K x D, K ~ 1e5-1e6) are selected in torch's float32 and only the
         # used columns converted: converting all of them first took 0.3 s per call at 10k vertices
-        W = net.decoder_head.weight.detach()
-        # a PCA-started decoder leaves the dimensions beyond the data's rank at exactly 0
-        size = W[:, :D].abs().amax(dim=0).double().numpy()
-        self.used = np.flatnonzero(size > tol.GN_UNUSED_DIM_RTOL * size.max())
+        W, b = linear
         self.W = W.index_select(1, torch.from_numpy(self.used)).double().numpy()
-        self.b = net.decoder_head.bias.detach().double().numpy()
+        self.b = b.double().numpy()
         self.Wc = W[:, D:].double().numpy()
 
-    def rows(self, z: np.ndarray, c) -> tuple[np.ndarray, np.ndarray | None]:
-        """Network rows (K,) float64 and, without hidden layers, the output's slope (K,)."""
-        if self.network.hidden:
-            rows, self._J = decoder_jacobian(self.network, z, c)
-            return rows, None
-        y = self.W @ z[self.used] + self.b
-        if self.network.n_conditions:
-            y = y + self.Wc @ np.asarray(c, dtype=np.float64)
-        return _activate(self.network, y)
-
     def state(self, z: np.ndarray, c, x: np.ndarray) -> "_DecodedState":
-        rows, slope = self.rows(z, c)
-        return _DecodedState(self, self.offset + self.scale * rows, slope, x)
+        """The decoded mesh of code ``z (D,)`` against the target ``x (n, 3)``, with what its Jacobian needs."""
+        if self.linear:
+            y = self.W @ z[self.used] + self.b
+            if self.network.n_conditions:
+                y = y + self.Wc @ np.asarray(c, dtype=np.float64)
+            rows, slope = output_slope(self.network.output, y)
+            network_jacobian = None
+        else:
+            rows, network_jacobian = decoder_jacobian(self.network, z, c)
+            slope = None
+        return _DecodedState(self.kind.linearize(self.offset + self.scale * rows), x, slope, network_jacobian)
 
     def feature_jacobian(self, state: "_DecodedState") -> np.ndarray:
-        """d features / d z[used]: (K, n_used) float64."""
-        if self.network.hidden:
-            return self.scale[:, None] * state.network_jacobian[:, self.used]
-        return (self.scale * state.slope)[:, None] * self.W
+        """d features / d z[used] at a decoded state: (K, n_used) float64."""
+        if self.linear:
+            return (self.scale * state.slope)[:, None] * self.W
+        return self.scale[:, None] * state.network_jacobian[:, self.used]
 
     def vertex_jacobian(self, state: "_DecodedState") -> np.ndarray:
         """d positions / d z[used] at a decoded state, rigid motions projected out: (3 n, n_used) float64."""
@@ -158,13 +123,12 @@ class _Decoder:
 
 
 class _DecodedState(FitState):
-    """A decoded code: :class:`FitState` plus what the network's Jacobian needs (the output's slope,
-    or with internal layers the network Jacobian computed with the rows)."""
+    """A decoded code: :class:`FitState` plus what the network's Jacobian needs: the output's slope
+    ``(K,)`` for a linear decoder, else the network's Jacobian ``(K, D)`` computed with the rows."""
 
-    def __init__(self, decoder: _Decoder, features: np.ndarray, slope, x: np.ndarray):
-        self.slope = slope
-        self.network_jacobian = getattr(decoder, "_J", None)
-        super().__init__(decoder.kind.linearize(features), x)
+    def __init__(self, lin, x: np.ndarray, slope: np.ndarray | None, network_jacobian: np.ndarray | None):
+        self.slope, self.network_jacobian = slope, network_jacobian
+        super().__init__(lin, x)
 
 
 def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: np.ndarray | None = None,
@@ -206,7 +170,7 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     V = np.asarray(vertices, dtype=np.float64)
     Z = np.array(z0, dtype=np.float64)
     report = GaussNewtonReport(len(V))
-    decoder = _Decoder(model, conditions)
+    decoder = LatentDecoder(model, conditions)
     used = decoder.used                    # none: the decoder ignores the code, nothing to fit
     if len(V):
         # build whatever the decoding builds on first use (the reconstructor's factorisations) here,
@@ -271,9 +235,6 @@ class GaussNewton(InferenceStrategy):
         return f"encoder + Gauss-Newton, {self.iterations} steps{chord}"
 
     def infer(self, model, vertices: np.ndarray, conditions: np.ndarray | None, progress: bool = False) -> np.ndarray:
-        if not hasattr(model.network, "decoder_head"):
-            raise ValueError(f"the gauss-newton inference needs the analytic Jacobian of a mesh-vae network; this one is"
-                             f" {model.network.architecture!r}: use inference='finite-difference' or 'encoder'")
         mu, _ = model.encode_rows(model.features_of(vertices), conditions)
         c = None if conditions is None else np.asarray(conditions, dtype=np.float64)
         Z, self.report_ = gauss_newton_codes(model, vertices, mu, c, iterations=self.iterations, progress=progress,
