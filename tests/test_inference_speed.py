@@ -168,3 +168,12 @@ def test_chord_steps_only_lower_the_error_and_zero_keeps_the_plain_method(bent):
     np.testing.assert_allclose(fit.u, [1.0, -2.0, 0.5, 3.0], atol=1e-2)
     with pytest.raises(ValueError, match="chord_steps"):
         marquardt_fit(np.zeros(4), Linear, lambda state: A, iterations=1, chord_steps=-1)
+
+
+def test_an_option_a_strategy_does_not_take_is_a_clear_error():
+    from meshvae_lib.model.inference import make_inference
+
+    with pytest.raises(ValueError, match=r"inference 'encoder' takes the options \(\), got \['iterations'\]"):
+        make_inference("encoder", iterations=2)
+    assert make_inference("gauss-newton", iterations=2, n_jobs=1).get_options() == {"iterations": 2, "n_jobs": 1,
+                                                                                     "chord_steps": 0}

@@ -41,7 +41,11 @@ def make_inference(spec, **options):
     """The strategy ``spec`` names (a registered name, built with ``options``), or ``spec`` itself
     when it already is a strategy (then ``options`` must be empty)."""
     if isinstance(spec, str):
-        return inference_class(spec)(**options)
+        cls = inference_class(spec)
+        unknown = sorted(set(options) - set(cls.options))
+        if unknown:
+            raise ValueError(f"inference {spec!r} takes the options {cls.options or '()'}, got {unknown}")
+        return cls(**options)
     if not hasattr(spec, "infer") or options:
         raise ValueError(f"inference must be one of {tuple(METHODS)} or a strategy, got {spec!r}")
     return spec

@@ -7,9 +7,10 @@ mesh are mostly reproduced in directions that matter little for the vertices. :c
 minimises instead the decoded mesh's squared vertex error, ``sum_k |decode(z)_k - (R v_k + t)|^2``
 over z and the best rigid motion (R, t), by Gauss-Newton from the encoder's means: each iteration
 takes the Jacobian of the decoded vertices with respect to the latent dimensions the decoder uses
-by forward differences (one decode + reconstruction per dimension), solves the linear
-least-squares step and halves it (up to 3 times) until the error falls. The decoder, normaliser
-and reconstruction are not changed: this is the same model, encoded by fitting.
+by forward differences (one decode + reconstruction per dimension), and takes the library's one
+Levenberg-Marquardt step (:func:`~meshvae_lib.model.inference.least_squares.marquardt_fit`: the
+default inference's loop with a difference Jacobian instead of the analytic one). The decoder,
+normaliser and reconstruction are not changed: this is the same model, encoded by fitting.
 Cost: ``iterations x (dimensions used + 1)`` decodes per mesh.
 """
 
@@ -18,13 +19,19 @@ from __future__ import annotations
 import numpy as np
 
 from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
-from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.model.inference.base import InferenceStrategy
+from meshvae_lib.model.inference.least_squares import FitState, marquardt_fit, without_rigid_motions
 from meshvae_lib.tolerances import FIT_LATENT_STEP
 from meshvae_lib.validation import check_count
 
 __all__ = ["VertexFit"]
 
+
+class _Decoded:
+    """A decoded mesh as :class:`FitState` reads it (``positions (n, 3)``), with its code."""
+
+    def __init__(self, positions: np.ndarray, code: np.ndarray):
+        self.positions, self.code = positions, code
 
 
 class VertexFit(InferenceStrategy):
@@ -52,36 +59,28 @@ class VertexFit(InferenceStrategy):
         mu, _ = model.encode_rows(model.features_of(vertices), conditions)
         Z = np.array(mu, dtype=np.float64)
         used = model.used_latent_dims
-        eye = np.eye(model.latent_dim)[used] * self.step
         for j in progress_bar(range(len(vertices)), desc="fitting codes", unit="mesh", disable=not progress):
             c = None if conditions is None else conditions[j]
-            Z[j] = self._fit_one(model, vertices[j], Z[j], c, used, eye)
+            Z[j][used] = self._fit_one(model, vertices[j], Z[j], c, used)
         return Z
 
-    def _fit_one(self, model, V: np.ndarray, z: np.ndarray, c, used: np.ndarray, eye: np.ndarray) -> np.ndarray:
-        """Gauss-Newton from ``z (D,)`` for the mesh ``V (n, 3)`` with condition ``c (C,)`` or None."""
-        err = None
-        for _ in range(self.iterations):
-            batch = np.vstack([z[None], z[None] + eye])
-            P = model.decode_latent(batch, conditions=None if c is None else np.broadcast_to(c, (len(batch), len(c))))
-            P0 = P[0]
-            target = rigid_align(V, P0)
-            r0 = (target - P0).ravel()
-            err = float(r0 @ r0) if err is None else err
-            J = ((P[1:] - P0).reshape(len(used), -1) / self.step).T  # (3n, d)
-            if not (np.isfinite(J).all() and np.isfinite(r0).all()):
-                break  # a non-finite decode: LAPACK's least squares may not return on it; keep z
-            dz, *_ = np.linalg.lstsq(J, r0, rcond=None)
-            t = 1.0
-            for _ in range(4):
-                z_new = z.copy()
-                z_new[used] += t * dz
-                Pn = model.decode_latent(z_new, conditions=c)
-                rn = (rigid_align(V, Pn) - Pn).ravel()
-                if float(rn @ rn) < err:
-                    z, err = z_new, float(rn @ rn)
-                    break
-                t *= 0.5
-            else:
-                break  # no step lowered the error: done
-        return z
+    def _fit_one(self, model, V: np.ndarray, z: np.ndarray, c, used: np.ndarray) -> np.ndarray:
+        """The used dimensions of the code fitted from ``z (D,)`` to the mesh ``V (n, 3)`` with
+        condition ``c (C,)`` or None: ``(n_used,) float64``."""
+        eye = np.eye(len(z))[used] * self.step
+
+        def decode(codes: np.ndarray) -> np.ndarray:
+            cond = None if c is None else np.broadcast_to(c, (len(codes), len(c)))
+            return model.decode_latent(codes, conditions=cond)
+
+        def state_at(u: np.ndarray) -> FitState:
+            code = z.copy()
+            code[used] = u
+            return FitState(_Decoded(decode(code[None])[0], code), V)
+
+        def jacobian_at(state: FitState) -> np.ndarray:
+            P = decode(state.lin.code[None] + eye)
+            J = ((P - state.lin.positions) / self.step).reshape(len(used), -1).T     # (3n, n_used)
+            return without_rigid_motions(J, state.lin.positions)
+
+        return marquardt_fit(z[used], state_at, jacobian_at, self.iterations).u
