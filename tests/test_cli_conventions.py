@@ -82,6 +82,8 @@ def _bad_values(root, data, feats, model):
         (["train", str(data), "-o", str(root / "x.pt"), "--latent", "0"], "--latent must be >= 1"),
         (["train", str(data), "-o", str(root / "x.pt"), "--labels", "colour"], "colour"),
         (["evaluate", str(model), str(data), "--fit-latent", "-1"], "--fit-latent must be >= 0"),
+        (["evaluate", str(model), str(data), "--jobs", "0"], "--jobs must be >= 1"),
+        (["evaluate", str(model), str(data), "--jobs", "2", "--inference", "encoder"], "--inference encoder"),
         (["evaluate", str(root / "missing.pt"), str(data)], "no checkpoint file at"),
         (["generate", str(model), "-n", "0", "-o", str(root / "x.npz")], "-n must be >= 1"),
         (["generate", str(model), "-o", str(root / "x.npz"), "--condition", "pose=a"], "without labels"),

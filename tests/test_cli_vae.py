@@ -58,7 +58,11 @@ def test_evaluate_json_and_text(data, capsys):
     assert res["n_meshes"] == 16 and res["mean_vertex_error"] >= 0
     assert res["mean_vertex_error"] == pytest.approx(np.mean(res["per_mesh"]), rel=1e-12)
     assert main(["evaluate", str(model), str(path), "--held-out", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["n_meshes"] == 4
+    every_core = json.loads(capsys.readouterr().out)
+    assert every_core["n_meshes"] == 4
+    assert main(["evaluate", str(model), str(path), "--held-out", "--json", "--jobs", "1"]) == 0
+    one = json.loads(capsys.readouterr().out)
+    assert one["per_mesh"] == every_core["per_mesh"] and one["inference"] == "gauss-newton"   # the same codes
     assert main(["evaluate", str(model), str(path)]) == 0
     assert "mean per-vertex error" in capsys.readouterr().out
 

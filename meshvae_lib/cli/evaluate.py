@@ -52,6 +52,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         " not held out (no value), or all meshes of the collection TRAIN")
     p.add_argument("--pca-components", type=int, default=None, metavar="K",
                    help="principal components of the PCA baseline (default: all the training meshes span)")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="processes fitting meshes at once with the default inference (default: every available"
+                        " core; the codes do not depend on it)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar while codes are fitted")
     add_allow_degenerate(p)
     return p
@@ -68,12 +71,21 @@ def run(args) -> int:
     check_at_most(args.fit_latent, MAX_SOLVER_STEPS, "--fit-latent", "Gauss-Newton steps per mesh")
     if args.pca_components is not None:
         check_at_least(args.pca_components, 1, "--pca-components")
+    inference = args.inference
+    if args.jobs is not None:
+        check_at_least(args.jobs, 1, "--jobs")
+        if args.fit_latent or inference not in (None, "gauss-newton"):
+            raise UsageError("--jobs sets the processes of the default inference (gauss-newton); it does not combine"
+                             f" with {'--fit-latent' if args.fit_latent else '--inference ' + str(inference)}")
+        from meshvae_lib.model.inference.gauss_newton import GaussNewton
+
+        inference = GaussNewton(n_jobs=args.jobs)
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
     if args.fit_latent and args.inference not in (None, "finite-difference"):
         raise UsageError(f"--fit-latent fits by finite differences; it does not combine with --inference {args.inference}")
     res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent,
-                         inference=args.inference, progress=not args.no_progress)
+                         inference=inference, progress=not args.no_progress)
     if args.pca is not None:
         import numpy as np
 
