@@ -22,10 +22,10 @@ import torch
 
 from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference.base import InferenceStrategy
-from meshvae_lib.model.networks import decoder_linearization
-from meshvae_lib.model.vae_linearization import output_slope
 from meshvae_lib.model.inference.least_squares import (  # noqa: F401 (re-exported)
     FitState, MarquardtFit, marquardt_fit, rigid_fields, without_rigid_motions)
+from meshvae_lib.model.networks import decoder_linearization
+from meshvae_lib.model.vae_linearization import output_slope
 from meshvae_lib.validation import check_count
 from meshvae_lib.workers import map_forked, resolve_jobs
 
@@ -172,7 +172,7 @@ def gauss_newton_codes(model, vertices: np.ndarray, z0: np.ndarray, conditions: 
     report = GaussNewtonReport(len(V))
     decoder = LatentDecoder(model, conditions)
     used = decoder.used                    # none: the decoder ignores the code, nothing to fit
-    if len(V):
+    if resolve_jobs(n_jobs, len(V)) > 1:
         # build whatever the decoding builds on first use (the reconstructor's factorisations) here,
         # once, rather than in every worker
         decoder.state(Z[0], None if conditions is None else conditions[0], V[0])
