@@ -177,3 +177,16 @@ def test_an_option_a_strategy_does_not_take_is_a_clear_error():
         make_inference("encoder", iterations=2)
     assert make_inference("gauss-newton", iterations=2, n_jobs=1).get_options() == {"iterations": 2, "n_jobs": 1,
                                                                                      "chord_steps": 0}
+
+
+def test_without_cholespy_the_factorisation_falls_back_to_superlu(monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "cholespy", None)        # an import of it now fails
+    assert spd_backend() == "superlu"
+    n = 30
+    M = (sp.diags([-np.ones(n - 1), 2.5 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])).tocsr()
+    factor = factorize_spd(M)
+    assert factor.backend == "superlu"
+    b = np.random.default_rng(4).standard_normal((n, 20))
+    np.testing.assert_allclose(M @ factor.solve(b), b, atol=1e-12)
