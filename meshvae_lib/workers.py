@@ -5,9 +5,10 @@ and most of a fit holds Python's interpreter lock (the sparse solves, the small 
 threads do not run it in parallel; processes do. :func:`map_forked` forks ``n_jobs`` workers that
 inherit everything already built (the model, its reconstructor's factorisations: nothing is pickled
 but the item's index and its result), and returns the results in item order, so the outcome does not
-depend on ``n_jobs``. Each worker keeps its parent's thread settings, so its floating-point
-reductions are the parent's (``tests/test_inference_speed.py``: the parallel codes equal the serial
-ones exactly).
+depend on ``n_jobs``. Each worker runs one BLAS and one torch thread (the workers fill the cores;
+with the parent's two threads each, two workers were 1.2x faster than one process instead of 1.7x on
+samba/3). ``tests/test_inference_speed.py`` checks that the parallel codes equal the serial ones
+exactly.
 
 Where ``fork`` is unavailable (not Linux), or inside a worker, the items run one after another.
 """
