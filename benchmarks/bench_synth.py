@@ -23,11 +23,9 @@ sys.path.insert(0, str(ROOT))
 
 
 def clear_caches() -> None:
-    from data_synth import face, hand, humanoid
+    from data_synth.registry import clear_caches as clear
 
-    humanoid._cached_template.cache_clear()
-    hand._cached.cache_clear()
-    face._cached.cache_clear()
+    clear()
 
 
 def time_collection(name: str, resolution, repeats: int):

@@ -87,9 +87,7 @@ def _parts(decode, latent_dim, viewer, moves):
         t1 = time.perf_counter()
         N = vertex_normals(V, viewer.F).astype(np.float32)
         t2 = time.perf_counter()
-        for i in range(viewer.n_meshes):
-            viewer._pos_attrs[i].array = V[i].astype(np.float32)
-            viewer._nrm_attrs[i].array = N[i]
+        viewer.set_buffers(V.astype(np.float32), N)
         t3 = time.perf_counter()
         dec.append(1e3 * (t1 - t0)); nrm.append(1e3 * (t2 - t1)); buf.append(1e3 * (t3 - t2))
     return float(np.median(dec)), float(np.median(nrm)), float(np.median(buf))

@@ -21,7 +21,7 @@ from data_synth import constants as C
 from data_synth.collection import SynthCollection, resolve_resolution
 from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 
-__all__ = ["make_face", "face_template", "blendshapes", "EXPRESSIONS"]
+__all__ = ["make_face", "face_template", "blendshapes", "EXPRESSIONS", "clear_template_cache"]
 
 #: expression -> blendshape weights at its peak ("jaw_open" and "lip_roll" are rotations, as fractions
 #: of ``FACE_JAW_ANGLE`` and ``FACE_LIP_ROLL``, not blendshapes)
@@ -240,3 +240,8 @@ def make_face(seed: int = 0, resolution: int | None = None,
         description="a head with expressions (blendshapes, rolling lips and a rotating jaw) turning on its neck",
         extras={"rest": V0, "blendshape_names": sorted(shapes)},  # rest: this seed's neutral
     )
+
+
+def clear_template_cache() -> None:
+    """Forget the templates built so far, so that the next collection builds them again."""
+    _cached.cache_clear()

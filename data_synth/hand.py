@@ -20,7 +20,7 @@ from data_synth.meshing import Capsule, Ellipsoid, ImplicitModel, polygonize
 from data_synth.skeleton import Skeleton, axis_rotation, forward_kinematics
 from data_synth.skinning import dual_quaternion_blend, skinning_weights
 
-__all__ = ["make_hand", "hand_template", "GESTURES", "FINGERS", "STEADY_FINGERS"]
+__all__ = ["make_hand", "hand_template", "GESTURES", "FINGERS", "STEADY_FINGERS", "clear_template_cache"]
 
 FINGERS = ("thumb", "index", "middle", "ring", "little")
 _X, _Y, _Z = np.eye(3)
@@ -180,3 +180,8 @@ def make_hand(seed: int = 0, resolution: int | None = None,
         description="a hand making gestures, every mesh its own pose of every finger joint and the wrist",
         extras={"rest": np.array(V0)},
     )
+
+
+def clear_template_cache() -> None:
+    """Forget the templates built so far, so that the next collection builds them again."""
+    _cached.cache_clear()

@@ -38,6 +38,7 @@ __all__ = [
     "body_template",
     "shape_body",
     "pose_body",
+    "clear_template_cache",
 ]
 
 #: joint names and parents (the bone of a joint runs from it to its ``BONE_END``).
@@ -306,3 +307,8 @@ def pose_body(V_rest: np.ndarray, joints_rest: np.ndarray, template: BodyTemplat
     R, p = forward_kinematics(template.skeleton, local, root_translation, rest=joints_rest)
     t = p - np.einsum("njab,jb->nja", R, joints_rest)
     return dual_quaternion_blend(V_rest, template.W, R, t, parents=template.skeleton.parents)
+
+
+def clear_template_cache() -> None:
+    """Forget the templates built so far, so that the next collection builds them again."""
+    _cached_template.cache_clear()

@@ -11,11 +11,11 @@ import numbers
 from dataclasses import dataclass
 from typing import Callable
 
-from data_synth import bar, bodies, face, flag, hand
+from data_synth import bar, bodies, face, flag, hand, humanoid
 from data_synth.capture_noise import with_capture_noise
 from data_synth.collection import SynthCollection
 
-__all__ = ["COLLECTIONS", "CollectionSpec", "list_collections", "make_collection", "SynthCollection"]
+__all__ = ["COLLECTIONS", "CollectionSpec", "list_collections", "make_collection", "clear_caches", "SynthCollection"]
 
 
 @dataclass(frozen=True)
@@ -93,3 +93,10 @@ def make_collection(name: str, seed: int = 0, resolution: int | None = None,
         raise ValueError(f"noise must be a finite number >= 0, got {noise!r}")
     collection = COLLECTIONS[name].build(seed=int(seed), resolution=resolution)
     return with_capture_noise(collection, float(noise), int(seed))
+
+
+def clear_caches() -> None:
+    """Forget the templates built so far (the body's, the hand's, the face's), so that the next
+    :func:`make_collection` builds them again (benchmarks time a cold build this way)."""
+    for module in (humanoid, hand, face):
+        module.clear_template_cache()

@@ -19,10 +19,15 @@ LAYOUTS = ("paper", "compact")
 DEFAULT_LAYOUT = "paper"
 #: how a sigma_object prior enters the latent cost (``vae.kl_divergence``).
 PRIOR_FORMS = ("exact", "sibling")
-#: the decoder's last activation (``vae.MeshVAE(output=...)``).
-OUTPUTS = ("tanh", "sigmoid")
-#: the reconstruction terms of ``vae.vae_loss`` (``loss=...``; "bce" needs the sigmoid output).
-LOSSES = ("mse", "bce")
+#: the decoder's last activation: the mesh VAE's tanh or sigmoid (``vae.MeshVAE(output=...)``), or none
+#: ("linear": the spiral network's, ``spiral_net.SpiralVAE``).
+OUTPUTS = ("tanh", "sigmoid", "linear")
+#: the reconstruction terms of ``vae.vae_loss`` (``loss=...``; "bce" needs the sigmoid output; "l1" is
+#: SpiralNet++'s).
+LOSSES = ("mse", "bce", "l1")
+#: the feature kinds whose rows are vertex positions (x0, y0, z0, x1, ...): what a network on the
+#: mesh's vertices (``spiral_net.SpiralVAE``) can read.
+POSITION_KINDS = ("coords", "aligned")
 #: network initialisations (``train_config.TrainConfig.init``) and the default.
 INIT_MODES = ("pca", "random")
 DEFAULT_INIT = "pca"
@@ -46,6 +51,14 @@ DEFAULT_LATENT = 128
 #: real collections (140-164 training meshes): with 128 dimensions even the training meshes came back
 #: above PCA's held-out error (docs/vae.md, "Inference by Gauss-Newton").
 PCA_LATENT_MAX = 256
+#: the spiral network's defaults (``spiral_net.SpiralVAE``): SpiralNet++'s reconstruction settings
+#: (Gong et al. 2019, their code's defaults): channel widths from the finest level down, spiral length,
+#: the down-sampling factor of each level (CoMA's), latent size and epochs (Adam at DEFAULT_LR, batch 32).
+SPIRAL_CHANNELS = (32, 32, 32, 64)
+SPIRAL_LENGTH = 9
+SPIRAL_DOWNSAMPLING = (4, 4, 4, 4)
+SPIRAL_LATENT = 16
+SPIRAL_EPOCHS = 300
 #: Adam learning rate.
 DEFAULT_LR = 1e-3
 #: slope of the leaky ReLU on internal layers.

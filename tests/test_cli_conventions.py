@@ -215,9 +215,10 @@ def _sub_parsers():
 def test_every_choices_list_is_a_library_constant():
     from meshvae_lib.model.feature_kinds import FEATURE_KINDS
     from meshvae_lib.model.inference import INFERENCE_METHODS
+    from meshvae_lib.model.networks import ARCHITECTURE_NAMES
 
     constants = [v for k, v in vars(defaults).items() if k.isupper() and isinstance(v, tuple)]
-    constants += [FEATURE_KINDS, INFERENCE_METHODS]  # the registries' names
+    constants += [FEATURE_KINDS, INFERENCE_METHODS, ARCHITECTURE_NAMES]  # the registries' names
     seen = 0
     for name, p in _sub_parsers().items():
         for action in p._actions:

@@ -204,3 +204,27 @@ def test_train_and_evaluate_accept_degenerate_faces_only_when_asked(tmp_path, ca
     assert main(["evaluate", str(out), str(path), "--allow-degenerate", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["n_meshes"] == 8 and np.isfinite(res["mean_vertex_error"])
+
+
+def test_train_a_spiral_network_from_the_command_line(tmp_path, capsys):
+    """--architecture spiral: coordinates by default, its own epochs, evaluated by Gauss-Newton; the
+    options it cannot take are refused before any data is read."""
+    coll = _strips(n=10, nx=40, ny=20)                       # 800 vertices: four levels of 4 fit
+    path = write_collection(tmp_path / "s.npz", coll)
+    out = tmp_path / "spiral.pt"
+    assert main(["train", str(path), "-o", str(out), "--architecture", "spiral", "--epochs", "2", "--latent", "2",
+                 "--holdout-every", "5", "--no-progress"]) == 0
+    text = capsys.readouterr()
+    assert "network spiral, features coords" in text.err + text.out and "held-out per-vertex error" in text.out
+    m = load_model(out, coll)
+    assert type(m.network).__name__ == "SpiralVAE" and m.feature_kind.name == "coords" and m.latent_dim == 2
+    assert m.config.epochs == 2 and m.config.loss == "l1"
+    for bad, why in ((["--features", "rimd"], "works on --features coords or aligned"),
+                     (["--hidden", "8"], "--hidden"), (["--labels", "pose"], "unconditional")):
+        capsys.readouterr()
+        assert main(["train", str(path), "-o", str(tmp_path / "x.pt"), "--architecture", "spiral", *bad]) == 2
+        assert why in capsys.readouterr().err
+    small = write_collection(tmp_path / "small.npz", _strips(n=6))
+    assert main(["train", str(small), "-o", str(tmp_path / "y.pt"), "--architecture", "spiral", "--epochs", "1",
+                 "--no-progress"]) == 2
+    assert "too few for down-sampling" in capsys.readouterr().err

@@ -294,7 +294,7 @@ def test_network_options_come_from_the_config_and_are_checked():
     assert res.model.sigma_floor == 1e-3 and res.model.output == "tanh"
     assert TrainConfig(sigma_floor=1e-3).uses_pca_init()  # the floor keeps the PCA start (tanh output)
     assert MeshVAE.from_pca(torch.from_numpy(X.astype(np.float32)), TrainConfig(sigma_floor=1e-3)).sigma_floor == 1e-3
-    for bad in (dict(loss="bce"), dict(loss="l1"), dict(output="relu"), dict(sigma_floor=-1.0)):
+    for bad in (dict(loss="bce"), dict(loss="huber"), dict(output="relu"), dict(output="linear"), dict(sigma_floor=-1.0)):
         with pytest.raises(ValueError):
             TrainConfig(**bad)
     with pytest.raises(ValueError, match="output"):

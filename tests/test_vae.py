@@ -193,4 +193,9 @@ def test_sigma_floor_and_sigmoid_output_are_options_of_the_network():
         with pytest.raises(ValueError):
             MeshVAE(12, 3, **bad)
     with pytest.raises(ValueError, match="loss"):
-        vae_loss(x, x, mu_a, s_a, loss="l1")
+        vae_loss(x, x, mu_a, s_a, loss="huber")
+    # the spiral network's L1 term, by hand: alpha / (M K) sum |x_hat - x|, the MSE logged beside it
+    x_hat = x + torch.arange(48, dtype=torch.float32).reshape(4, 12) / 100
+    parts = vae_loss(x_hat, x, mu_a, s_a, alpha=10.0, loss="l1")
+    assert float(parts["reconstruction"]) == pytest.approx(10.0 * np.arange(48).mean() / 100, rel=1e-6)
+    assert float(parts["mse"]) == pytest.approx(np.mean((np.arange(48) / 100) ** 2), rel=1e-5)

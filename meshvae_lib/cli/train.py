@@ -6,10 +6,11 @@ import argparse
 import logging
 import re
 
-from meshvae_lib.defaults import DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
+from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
-from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS
+from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS, SPIRAL_EPOCHS, SPIRAL_LATENT
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
+from meshvae_lib.model.networks import ARCHITECTURE_NAMES
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
                check_at_most, check_number, check_output, note, result)
 
@@ -32,6 +33,7 @@ examples:
   meshvae train dyna.npz -o dyna_cond.pt --labels shape motion
   meshvae train scape.npz -o explore.pt --sigma-object 0.1,0.1,0.5,0.5
   meshvae train jumping.npz -o coords.pt --features coords --holdout-every 5
+  meshvae train scape.npz -o spiral.pt --architecture spiral --holdout-every 5
 """
 
 
@@ -49,7 +51,7 @@ def _floats(text: str) -> list[float]:
 OPTIONS = {"epochs": "--epochs", "batch_size": "--batch-size", "lr": "--lr", "alpha": "--alpha",
            "latent_dim": "--latent", "hidden": "--hidden", "sigma_object": "--sigma-object",
            "prior_form": "--prior-form", "seed": "--seed", "init": "--init", "device": "--device",
-           "early_stopping": "--no-early-stopping", "progress": "--no-progress"}
+           "early_stopping": "--no-early-stopping", "progress": "--no-progress", "architecture": "--architecture"}
 
 
 def _option_names(text: str) -> str:
@@ -99,18 +101,44 @@ def _network_parameters(n_features: int, hidden, latent: int) -> int:
     return enc + dec
 
 
+def _network_choices(args) -> tuple[int, ...]:
+    """Check ``--architecture`` against ``--features``, ``--hidden`` and ``--labels`` (setting the
+    architecture's default feature kind when none is given); returns the internal layer sizes."""
+    from meshvae_lib.model.networks import network_class
+    from meshvae_lib.model.train_config import default_hidden
+
+    net_kinds = getattr(network_class(args.architecture), "kinds", None)
+    if args.features is None:
+        args.features = net_kinds[0] if net_kinds else DEFAULT_FEATURE_KIND
+    if net_kinds and args.features not in net_kinds:
+        raise UsageError(f"--architecture {args.architecture} works on --features {' or '.join(net_kinds)},"
+                         f" not {args.features}")
+    if args.architecture == DEFAULT_ARCHITECTURE:
+        return tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
+    if args.hidden:
+        raise UsageError(f"--hidden is the {DEFAULT_ARCHITECTURE} network's; --architecture {args.architecture} has its own layers")
+    if args.labels:
+        raise UsageError(f"--architecture {args.architecture} is unconditional: no --labels")
+    return ()
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
     add_output_argument(p, "MODEL.pt", "checkpoint file to write")
-    p.add_argument("--features", choices=FEATURE_KINDS, default=DEFAULT_FEATURE_KIND,
+    p.add_argument("--features", choices=FEATURE_KINDS, default=None,
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
-                   f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND})")
+                   f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND}; for the"
+                   " spiral network, coords)")
+    p.add_argument("--architecture", choices=ARCHITECTURE_NAMES, default=DEFAULT_ARCHITECTURE,
+                   help=f"the network: the paper's fully connected mesh VAE ({DEFAULT_ARCHITECTURE}, default) or a"
+                        f" spiral-convolution network on vertex positions (spiral: SpiralNet++'s settings, latent {SPIRAL_LATENT},"
+                        f" {SPIRAL_EPOCHS} epochs, L1 loss)")
     p.add_argument("--latent", type=int, default=None, metavar="D",
                    help=f"latent size (default {DEFAULT_LATENT}, or with the PCA start one per direction the training"
                         f" meshes span when that is more, up to {PCA_LATENT_MAX})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
-                   help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS})")
+                   help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS}; spiral: {SPIRAL_EPOCHS})")
     p.add_argument("--init", choices=INIT_MODES, default=DEFAULT_INIT,
                    help="pca (default): start from the PCA of the training features (networks without internal"
                         " layers, standard prior, no labels; docs/vae.md); random: PyTorch's initialisation (the paper)")
@@ -145,7 +173,7 @@ def run(args) -> int:
     from meshvae_lib.model.training import TrainingDiverged
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.collection_io import read_collection
-    from meshvae_lib.model.train_config import TrainConfig, default_hidden
+    from meshvae_lib.model.train_config import TrainConfig
 
     # every value is checked before the data is read and any training starts
     if args.latent is not None:
@@ -165,11 +193,9 @@ def run(args) -> int:
     check_at_least(args.seed, 0, "--seed")
     _check_device(args.device)
     check_output(args.output, parents=True)  # model.save creates missing folders
-    d = TrainConfig()
-    epochs = args.epochs if args.epochs is not None else d.epochs
-    hidden = tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
+    hidden = _network_choices(args)
     try:
-        config = TrainConfig(epochs=epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
+        config = TrainConfig(architecture=args.architecture, epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
                              latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
                              prior_form=args.prior_form, seed=args.seed, init=args.init,
                              early_stopping=False if args.no_early_stopping else None,
@@ -183,13 +209,13 @@ def run(args) -> int:
     n_features = (3 * collection.n_vertices if args.features != "rimd"
                   else 6 * collection.n_vertices + 9 * len(collection.faces))  # RIMD: 6V + 6E, E <= 3F/2
     n_params = _network_parameters(n_features, hidden, args.latent or PCA_LATENT_MAX)
-    if n_params > MAX_NETWORK_PARAMETERS:
+    if args.architecture == DEFAULT_ARCHITECTURE and n_params > MAX_NETWORK_PARAMETERS:
         raise UsageError(f"the network would have about {n_params:,} weights (K = {n_features:,} features,"
                          f" --hidden {' '.join(map(str, hidden)) or '(none)'}, --latent {args.latent or 'auto'});"
                          f" the limit is {MAX_NETWORK_PARAMETERS:,}: choose smaller --hidden or --latent")
     at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
-    note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, features {args.features},"
-         f" latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{epochs} epochs")
+    note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, network {args.architecture},"
+         f" features {args.features}, latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{config.epochs} epochs")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference)
     try:

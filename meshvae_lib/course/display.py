@@ -12,7 +12,12 @@ import numpy as np
 from meshvae_lib.tolerances import TIE_RTOL
 
 __all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table",
-           "describe_model", "model_summary"]
+           "spiral_table", "spiral_figure", "describe_model", "model_summary"]
+
+#: the columns of :func:`spiral_table` and :func:`spiral_figure`: (record key, inference, label).
+_SPIRAL_COLUMNS = (("pca", None, "PCA coords"), ("spiral", "encoder", "spiral enc"),
+                   ("spiral", "gauss_newton", "spiral GN"), ("rimd_equal", "encoder", "RIMD enc"),
+                   ("rimd_equal", "gauss_newton", "RIMD GN"), ("rimd_default", "gauss_newton", "RIMD default"))
 
 
 def roundoff(x: float, below: float = 1e-10) -> str:
@@ -106,6 +111,49 @@ def span_ceiling_table(rows) -> str:
                      f" {r['vertex_optimal'] / pca:6.2f} {r['default'] / pca:6.2f}"
                      f" | {r['vertex_optimal_below_pca']} of {r['n_meshes']}")
     return "\n".join(lines)
+
+
+def _spiral_cell(r: dict, key: str, how) -> float:
+    return float(r[key]) if how is None else float(r[key][how]["error"])
+
+
+def spiral_table(records) -> str:
+    """The spiral network beside the paper's network and PCA at one latent size, recorded
+    (``docs/results/spiral_real.json``, written by ``benchmarks/spiral_comparison.py``: one dict per
+    collection with ``collection``, ``source``, ``vertices``, ``latent`` D, ``pca`` (PCA on
+    coordinates with D directions), ``pca_all`` (with every direction), and ``spiral``, ``rimd_equal``
+    (RIMD at latent D), ``rimd_default`` (RIMD, latent resolved: more than D used dimensions), each
+    with ``used``, ``train_seconds`` and the ``encoder`` and ``gauss_newton`` errors) as a
+    fixed-width table; the default's column says how many dimensions it used. Recorded numbers, the
+    same on every machine."""
+    head = f"{'collection':22s} {'verts':>6s} {'D':>3s} " + " ".join(f"{label:>12s}" for _, _, label in _SPIRAL_COLUMNS)
+    lines = [head + "  (dims of the default) | spiral GN / PCA, RIMD GN / PCA"]
+    for r in records:
+        cells = [_spiral_cell(r, k, h) for k, h, _ in _SPIRAL_COLUMNS]
+        name = f"{r['collection']} ({'real' if r['source'] == 'real' else 'stand-in'})"
+        lines.append(f"{name:22s} {r['vertices']:6d} {r['latent']:3d} " + " ".join(f"{c:12.2e}" for c in cells)
+                     + f"  ({r['rimd_default']['used']:3d})             | {cells[2] / cells[0]:6.2f}, {cells[4] / cells[0]:6.2f}")
+    return "\n".join(lines)
+
+
+def spiral_figure(records):
+    """Grouped bars of :func:`spiral_table` (log scale, one group per collection); the default's bar
+    is hatched: it has more latent dimensions than the others. Returns the matplotlib figure."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9.5, 3.6))
+    width = 0.8 / len(_SPIRAL_COLUMNS)
+    for j, (key, how, label) in enumerate(_SPIRAL_COLUMNS):
+        values = [_spiral_cell(r, key, how) for r in records]
+        ax.bar(np.arange(len(records)) + (j - (len(_SPIRAL_COLUMNS) - 1) / 2) * width, values, width, label=label,
+               color=f"C{j}", hatch="//" if key == "rimd_default" else None, edgecolor="white" if key == "rimd_default" else None)
+    ax.set_yscale("log")
+    ax.set_xticks(np.arange(len(records)), [f"{r['collection']}\n{r['vertices']:,} vertices" for r in records])
+    ax.set_ylabel("held-out mean vertex error")
+    ax.set_title(f"latent size D = {records[0]['latent']} (the hatched default uses more)")
+    ax.legend(ncol=3, fontsize=8, frameon=False)
+    fig.tight_layout()
+    return fig
 
 
 def describe_model(model) -> dict:

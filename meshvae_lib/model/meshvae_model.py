@@ -27,7 +27,7 @@ from meshvae_lib.model import checkpoint
 from meshvae_lib.model.conditions import ConditionEncoder
 from meshvae_lib.model.feature_kinds import kind_from_state, make_kind
 from meshvae_lib.model.inference import make_inference
-from meshvae_lib.model.networks import network_from_config
+from meshvae_lib.model.networks import ReferenceMesh, network_from_config
 from meshvae_lib.model.normalization import FeatureNormalizer
 from meshvae_lib.model.train_config import TrainConfig, pad_sigma_object
 from meshvae_lib.model.training import from_output_range, train_vae, training_split
@@ -118,11 +118,10 @@ class MeshVAEModel:
         Xn = normalizer.transform(X)
         conditions = ConditionEncoder(self.labels).fit({c: np.asarray(labels[c])[~mask] for c in self.labels})
         C = conditions.transform(labels) if self.labels else None
-        result = train_vae(
-            Xn[~mask], None if C is None else C[~mask], config,
-            val_features=Xn[mask] if mask.any() else None,
-            val_conditions=None if C is None or not mask.any() else C[mask],
-        )
+        result = train_vae(Xn[~mask], None if C is None else C[~mask], config,
+                           val_features=Xn[mask] if mask.any() else None,
+                           val_conditions=None if C is None or not mask.any() else C[mask],
+                           mesh=ReferenceMesh(kind.reference, kind.faces, self.features))
         D = result.model.latent_dim
         so = pad_sigma_object(config.sigma_object, D)
         self.kind_, self.normalizer_, self.conditions_, self.network_ = kind, normalizer, conditions, result.model

@@ -9,7 +9,12 @@ name (the network's ``architecture`` attribute, recorded in checkpoints) to its 
 
 To add an architecture: write a module with a class that follows :class:`Network` and add one
 line to :data:`ARCHITECTURES`; ``TrainConfig(architecture=...)`` trains it, and the checkpoint
-stores and rebuilds it by name. Every inference works on it unchanged: the decoder's linearisation
+stores and rebuilds it by name. The class owns its configuration: ``start`` receives the rows, the
+resolved config and the :class:`ReferenceMesh` (faces, reference positions, feature kind), and
+optional class attributes say what ``TrainConfig`` leaves unset means for it (``train_defaults``:
+epochs, output, loss, latent size), which outputs it has (``outputs``), which
+``TrainConfig.network_options`` it takes (``options``) and whether it has the PCA start
+(``pca_start``). Every inference works on it unchanged: the decoder's linearisation
 (:func:`decoder_linearization`) comes from autograd unless the class has a closed form of its own
 (``decoder_jacobian``), and a decoder that is one linear map and an activation can say so
 (``linear_decoder``) for the Gauss-Newton inference's fast path.
@@ -17,20 +22,41 @@ stores and rebuilds it by name. Every inference works on it unchanged: the decod
 
 from __future__ import annotations
 
+import warnings
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
+from meshvae_lib.defaults import DEFAULT_EPOCHS
 from meshvae_lib.model.registry import registered_class
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
     import torch
 
-__all__ = ["Network", "ARCHITECTURES", "network_class", "start_network", "network_from_config", "decoder_linearization"]
+__all__ = ["Network", "ReferenceMesh", "ARCHITECTURES", "ARCHITECTURE_NAMES", "network_class", "start_network",
+           "network_from_config", "train_defaults", "decoder_linearization"]
 
 #: architecture name -> "module:Class" of a network that follows :class:`Network`.
 ARCHITECTURES = {
     "mesh-vae": "meshvae_lib.model.vae:MeshVAE",
+    "spiral": "meshvae_lib.model.spiral_net:SpiralVAE",
 }
+#: the registered architectures' names (the ``choices`` of ``meshvae train --architecture``).
+ARCHITECTURE_NAMES = tuple(ARCHITECTURES)
+
+#: what a network's ``TrainConfig`` leaves unset means unless its class says otherwise
+#: (``train_defaults``): the mesh VAE's.
+_TRAIN_DEFAULTS = {"epochs": DEFAULT_EPOCHS, "output": "tanh", "loss": "mse"}
+
+
+@dataclass(frozen=True)
+class ReferenceMesh:
+    """What a network's ``start`` may read of the mesh besides the rows: ``vertices (n, 3)`` float64
+    (the reference mesh), ``faces (n_faces, 3)`` int64 and ``kind``, the feature kind's name."""
+
+    vertices: "np.ndarray"
+    faces: "np.ndarray"
+    kind: str
 
 
 @runtime_checkable
@@ -62,6 +88,10 @@ class Network(Protocol):
     def config(self) -> dict:
         """Everything ``from_config`` needs to rebuild the network (plain numbers, strings, lists)."""
 
+    @classmethod
+    def start(cls, x, n_conditions: int, config, mesh: ReferenceMesh | None) -> "Network":
+        """A new network to train on rows ``x`` of ``mesh`` (``config.latent_dim`` resolved)."""
+
     def used_latent_dims(self) -> "np.ndarray":
         """Indices of the latent dimensions the decoder reads (all of them unless it knows better)."""
 
@@ -71,11 +101,18 @@ def network_class(architecture: str) -> type:
     return registered_class(ARCHITECTURES, architecture, "architecture")
 
 
-def start_network(architecture: str, x, n_conditions: int, config) -> Network:
-    """A new network of ``architecture`` to train on rows ``x (N, K)`` float32 with ``n_conditions``
-    condition inputs and the :class:`~meshvae_lib.model.train_config.TrainConfig` ``config`` (the
-    caller seeds torch's generator)."""
-    return network_class(architecture).start(x, n_conditions, config)
+def start_network(architecture: str, x, n_conditions: int, config, mesh: ReferenceMesh | None = None) -> Network:
+    """A new network of ``architecture`` to train on rows ``x (N, K)`` float32 of ``mesh`` with
+    ``n_conditions`` condition inputs and the :class:`~meshvae_lib.model.train_config.TrainConfig`
+    ``config``, its latent size resolved (the caller seeds torch's generator)."""
+    return network_class(architecture).start(x, n_conditions, config, mesh)
+
+
+def train_defaults(architecture: str) -> dict:
+    """What ``TrainConfig``'s ``epochs``, ``output`` and ``loss`` (and, where the class says,
+    ``latent_dim``) mean for ``architecture`` when left unset: the class's ``train_defaults`` over
+    the mesh VAE's."""
+    return {**_TRAIN_DEFAULTS, **getattr(network_class(architecture), "train_defaults", {})}
 
 
 def network_from_config(architecture: str, config: dict) -> Network:
@@ -112,6 +149,8 @@ def decoder_linearization(network, z, c=None) -> "tuple[np.ndarray, np.ndarray]"
 
     with torch.no_grad():
         rows = decode(zt)
-    J = torch.func.jacfwd(decode)(zt)
+    with warnings.catch_warnings():  # torch's first forward-mode use scripts its decompositions (torch 2.13 warns)
+        warnings.filterwarnings("ignore", message=r".*torch\.jit\.script.* is deprecated", category=DeprecationWarning)
+        J = torch.func.jacfwd(decode)(zt)
     return rows.double().numpy(), J.detach().double().numpy()
 

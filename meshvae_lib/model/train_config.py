@@ -4,16 +4,16 @@ the default network size per feature kind and the prior deviations sigma_object 
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_ARCHITECTURE, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS,
+from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_ARCHITECTURE, DEFAULT_BATCH_SIZE,
                                   DEFAULT_FEATURE_KIND, DEFAULT_INIT, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX,
                                   EARLY_STOPPING_PATIENCE, INIT_MODES, LOSSES, NORMALIZE_A, OUTPUTS,
                                   PCA_NORMALIZE_A, PRIOR_FORMS, VALIDATION_EVERY)
 from meshvae_lib.model.feature_kinds import kind_class
-from meshvae_lib.model.networks import ARCHITECTURES
+from meshvae_lib.model.networks import ARCHITECTURES, network_class, train_defaults
 from meshvae_lib.validation import check_choice
 
 __all__ = ["TrainConfig", "default_hidden", "pad_sigma_object"]
@@ -51,12 +51,13 @@ def pad_sigma_object(sigma_object, latent_dim: int) -> np.ndarray | None:
 class TrainConfig:
     """Training settings. The defaults train a good model for collections of 50-200 meshes.
 
-    epochs : passes over the training set.
+    epochs : passes over the training set (None: the architecture's, 1000 for the mesh VAE, 300
+        for the spiral network).
     batch_size : meshes per Adam step (the last batch is merged so that none has a single mesh,
         which batch norm cannot handle).
     lr : Adam learning rate (paper: 1e-3).
     alpha : weight of the reconstruction term (Eq. 4; paper: 1e6).
-    latent_dim : D (paper: 128). None (default): 128, except for a network that starts at the
+    latent_dim : D (paper: 128). None (default): the architecture's (128; the spiral network's 16), except for a network that starts at the
         PCA of its rows (``uses_pca_init``), which gets one dimension per direction its N training
         rows span, ``N - 1``, when that is more (at most ``PCA_LATENT_MAX``): with fewer, the PCA
         start drops the smallest directions and the training meshes themselves are not reproduced
@@ -73,7 +74,11 @@ class TrainConfig:
     eval_every : evaluate the held-out rows every this many epochs (and at the last epoch); also
         how often early stopping looks at its validation meshes.
     architecture : the network (a name of :data:`~meshvae_lib.model.networks.ARCHITECTURES`;
-        default ``"mesh-vae"``, :class:`~meshvae_lib.model.vae.MeshVAE`).
+        default ``"mesh-vae"``, :class:`~meshvae_lib.model.vae.MeshVAE`; ``"spiral"``,
+        :class:`~meshvae_lib.model.spiral_net.SpiralVAE`). What ``epochs``, ``output``, ``loss`` and
+        ``latent_dim`` left at None mean is the architecture's (:func:`~meshvae_lib.model.networks.train_defaults`).
+    network_options : the architecture's own options (the spiral network's ``channels``,
+        ``spiral_length``, ``factors``); empty: its defaults.
     init : "pca" (default) or "random" (PyTorch's initialisation: the paper's training; with
         ``early_stopping=False`` all ``epochs`` are trained, as the paper does). The PCA start is
         the library's departure from the paper: on real meshes the paper's training generalised
@@ -103,13 +108,14 @@ class TrainConfig:
         otherwise.
     sigma_floor, output : the new network's options (see :class:`~meshvae_lib.model.vae.MeshVAE`):
         a floor added to the deviation (default 0) and the decoder's last activation, "tanh"
-        (default) or "sigmoid". A sigmoid network is trained on the rows mapped to
+        (the mesh VAE's default) or "sigmoid" ("linear" for the spiral network). A sigmoid network is trained on the rows mapped to
         ``BCE_TARGET_RANGE`` (:func:`to_output_range`) and is never PCA-initialised.
-    loss : the reconstruction term, "mse" (Eq. 4, default) or "bce" (binary cross-entropy, needs
-        ``output="sigmoid"``; see :func:`~meshvae_lib.model.vae.vae_loss`).
+    loss : the reconstruction term, "mse" (Eq. 4, the mesh VAE's default), "bce" (binary
+        cross-entropy, needs ``output="sigmoid"``) or "l1" (the spiral network's default; see
+        :func:`~meshvae_lib.model.vae.vae_loss`).
     """
 
-    epochs: int = DEFAULT_EPOCHS
+    epochs: int | None = None
     batch_size: int = DEFAULT_BATCH_SIZE
     lr: float = DEFAULT_LR
     alpha: float = DEFAULT_ALPHA
@@ -128,9 +134,10 @@ class TrainConfig:
     patience: int = EARLY_STOPPING_PATIENCE
     feature_scale: str | None = None
     sigma_floor: float = 0.0
-    output: str = "tanh"
-    loss: str = "mse"
+    output: str | None = None
+    loss: str | None = None
     architecture: str = DEFAULT_ARCHITECTURE
+    network_options: dict = field(default_factory=dict)
 
     # The resolvers: what the options left at None mean for a network with ``n_conditions``
     # condition inputs (the estimator and the trainer both ask these, nobody else decides).
@@ -138,7 +145,7 @@ class TrainConfig:
         """True when a new network starts at the PCA of its rows (:meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`;
         see ``init``)."""
         return (self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
-                and self.output == "tanh")
+                and self.output == "tanh" and bool(getattr(network_class(self.architecture), "pca_start", False)))
 
     def resolved_latent_dim(self, n_rows: int, n_conditions: int = 0) -> int:
         """D for a new network trained on ``n_rows`` rows (see ``latent_dim``)."""
@@ -146,7 +153,7 @@ class TrainConfig:
             return int(self.latent_dim)
         if self.uses_pca_init(n_conditions):
             return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
-        return DEFAULT_LATENT
+        return int(train_defaults(self.architecture).get("latent_dim", DEFAULT_LATENT))
 
     def resolved_a(self, n_conditions: int = 0) -> float:
         """a of Eq. 3 (see ``a``)."""
@@ -168,6 +175,18 @@ class TrainConfig:
         return self.uses_pca_init(n_conditions)
 
     def __post_init__(self):
+        if self.architecture not in ARCHITECTURES:
+            raise ValueError(f"TrainConfig.architecture must be one of {tuple(ARCHITECTURES)}, got {self.architecture!r}")
+        unset = train_defaults(self.architecture)
+        for name in ("epochs", "output", "loss"):
+            if getattr(self, name) is None:
+                setattr(self, name, unset[name])
+        self.network_options = dict(self.network_options or {})
+        net = network_class(self.architecture)
+        known = dict(getattr(net, "options", {}))
+        if set(self.network_options) - set(known):
+            raise ValueError(f"TrainConfig.network_options: the {self.architecture!r} network takes"
+                             f" {sorted(known) or 'none'}, got {sorted(self.network_options)}")
         self.hidden = tuple(int(h) for h in self.hidden)
         if self.sigma_object is not None:
             self.sigma_object = tuple(float(s) for s in self.sigma_object)
@@ -186,9 +205,8 @@ class TrainConfig:
             "patience": self.patience >= 1,
             "feature_scale": self.feature_scale in (None, "component", "shared"),
             "sigma_floor": 0.0 <= float(self.sigma_floor) < float("inf"),
-            "output": self.output in OUTPUTS,
+            "output": self.output in getattr(net, "outputs", OUTPUTS),
             "loss": self.loss in LOSSES and (self.loss != "bce" or self.output == "sigmoid"),
-            "architecture": self.architecture in ARCHITECTURES,
         }
         for name, ok in checks.items():
             if not ok:
@@ -198,4 +216,5 @@ class TrainConfig:
         d = asdict(self)
         d["hidden"] = list(self.hidden)
         d["sigma_object"] = None if self.sigma_object is None else list(self.sigma_object)
+        d["network_options"] = {k: (list(v) if isinstance(v, (tuple, list)) else v) for k, v in self.network_options.items()}
         return d

@@ -110,9 +110,9 @@ def _as_tensor(x, name: str, rows: int | None = None) -> torch.Tensor:
 
 def to_output_range(x, a: float, output: str = "sigmoid"):
     """Rows normalised to [-a, a] (Eq. 3) -> what a network with ``output`` reproduces: the rows
-    themselves for "tanh", for "sigmoid" the affine map onto ``BCE_TARGET_RANGE`` ([0.1, 0.9]).
+    themselves for "tanh" and "linear", for "sigmoid" the affine map onto ``BCE_TARGET_RANGE`` ([0.1, 0.9]).
     numpy arrays or tensors."""
-    if output == "tanh":
+    if output != "sigmoid":
         return x
     lo, hi = BCE_TARGET_RANGE
     return lo + (x + a) * (hi - lo) / (2 * a)
@@ -120,7 +120,7 @@ def to_output_range(x, a: float, output: str = "sigmoid"):
 
 def from_output_range(p, a: float, output: str = "sigmoid"):
     """The inverse of :func:`to_output_range`: a network's decoded rows -> rows in [-a, a]."""
-    if output == "tanh":
+    if output != "sigmoid":
         return p
     lo, hi = BCE_TARGET_RANGE
     return (p - lo) * (2 * a) / (hi - lo) - a
@@ -141,7 +141,7 @@ class _Loss:
 
     def mse_scale(self, model) -> float | None:
         """Factor from the network's output units to Eq. 3's for the logged MSE (None: the same)."""
-        if model.output == "tanh":
+        if model.output != "sigmoid":
             return None
         lo, hi = BCE_TARGET_RANGE
         return (2 * self.a / (hi - lo)) ** 2
@@ -167,10 +167,10 @@ def _batches(n: int, batch_size: int, perm: torch.Tensor) -> list[torch.Tensor]:
     return list(torch.tensor_split(perm, n_batches))
 
 
-def _new_network(x, n_cond, config) -> Network:
+def _new_network(x, n_cond, config, mesh) -> Network:
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
-        return start_network(config.architecture, x, n_cond, config)
+        return start_network(config.architecture, x, n_cond, config, mesh)
 
 
 def _epochs(model, x, c, loss: _Loss, epochs: int, device, desc: str):
@@ -279,14 +279,14 @@ def _check_given(model, k: int, n_cond: int, config: TrainConfig) -> None:
                          f" the config asks for output={config.output!r}, sigma_floor={config.sigma_floor:g}")
 
 
-def _select(x, c, n_cond: int, loss: _Loss, device) -> tuple[int, dict]:
+def _select(x, c, n_cond: int, loss: _Loss, device, mesh) -> tuple[int, dict]:
     """Early stopping: a network trained on all but every ``validation_every``-th row, validated on
     those. Returns (the best number of epochs, the record of ``TrainResult.selection``)."""
     config = loss.config
     vmask = holdout_mask(x.shape[0], config.validation_every)
     fit_i, val_i = torch.from_numpy(np.flatnonzero(~vmask)), torch.from_numpy(np.flatnonzero(vmask))
     x_fit = x[fit_i]
-    probe = _new_network(x_fit, n_cond, config).to(device)
+    probe = _new_network(x_fit, n_cond, config, mesh).to(device)
     history, epochs = _choose_epochs(probe, x_fit.to(device), None if c is None else c[fit_i].to(device),
                                      x[val_i].to(device), None if c is None else c[val_i].to(device), loss, device)
     logger.info("early stopping chose %d epochs (validation MSE %s)", epochs, min(h["val_mse"] for h in history))
@@ -315,6 +315,7 @@ def train_vae(
     val_features=None,
     val_conditions=None,
     model: Network | None = None,
+    mesh=None,
 ) -> TrainResult:
     """Train a mesh VAE on normalised feature rows.
 
@@ -331,6 +332,11 @@ def train_vae(
         history (``val_*``), never used to choose anything.
     model : continue training this network instead of building a new one (no PCA initialisation
         and no early stopping then, unless ``config.early_stopping`` is True, which is refused).
+    mesh : the :class:`~meshvae_lib.model.networks.ReferenceMesh` the rows come from, for a network
+        built on the mesh's connectivity (the spiral network); None where the network needs none.
+
+    The latent size is resolved here and only here (``config.resolved_latent_dim``: the
+    architecture's rule) before the network's ``start``.
 
     Returns
     -------
@@ -357,9 +363,9 @@ def train_vae(
         epochs, selection = 0, {"epochs": 0, "skipped": START_IS_OPTIMUM}
         logger.info("no epoch search: %s", START_IS_OPTIMUM)
     elif early:
-        epochs, selection = _select(x, c, n_cond, loss, device)
+        epochs, selection = _select(x, c, n_cond, loss, device, mesh)
     if model is None:
-        model = _new_network(x, n_cond, config)
+        model = _new_network(x, n_cond, config, mesh)
     model.to(device)
     x, c = x.to(device), None if c is None else c.to(device)
     xv, cv = (None, None) if xv is None else (xv.to(device), None if cv is None else cv.to(device))

@@ -41,7 +41,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, OUTPUTS, PRIOR_FORMS, SIGMA_MAX
+from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_EPOCHS, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, PRIOR_FORMS, SIGMA_MAX
 from meshvae_lib.model.inplace_grad import Linear
 from meshvae_lib.model.pca_start import pca_start
 from meshvae_lib.tolerances import GN_UNUSED_DIM_RTOL, SIGMA_LOGIT_MIN
@@ -85,6 +85,11 @@ class MeshVAE(nn.Module):
 
     #: the architecture's name in :data:`meshvae_lib.model.networks.ARCHITECTURES`.
     architecture = "mesh-vae"
+    #: the decoder's last activations it has, and what ``TrainConfig`` leaves unset means for it.
+    outputs = ("tanh", "sigmoid")
+    train_defaults = {"epochs": DEFAULT_EPOCHS, "output": "tanh", "loss": "mse"}
+    #: it can start at the PCA of its rows (:meth:`from_pca`; ``TrainConfig.uses_pca_init``).
+    pca_start = True
 
     def __init__(
         self,
@@ -113,8 +118,8 @@ class MeshVAE(nn.Module):
             raise ValueError(f"sigma_max must be positive, got {sigma_max}")
         if not 0.0 <= float(sigma_floor) < float("inf"):
             raise ValueError(f"sigma_floor must be finite and >= 0, got {sigma_floor}")
-        if output not in OUTPUTS:
-            raise ValueError(f"output must be one of {OUTPUTS}, got {output!r}")
+        if output not in self.outputs:
+            raise ValueError(f"output must be one of {self.outputs}, got {output!r}")
         self.n_features = int(n_features)
         self.latent_dim = int(latent_dim)
         self.hidden = hidden
@@ -166,14 +171,15 @@ class MeshVAE(nn.Module):
         return cls(**config)
 
     @classmethod
-    def start(cls, x: torch.Tensor, n_conditions: int, config) -> "MeshVAE":
+    def start(cls, x: torch.Tensor, n_conditions: int, config, mesh=None) -> "MeshVAE":
         """A new network to train on rows ``x (N, K)`` float32 with ``config`` (a
-        :class:`~meshvae_lib.model.train_config.TrainConfig`): the PCA start (:meth:`from_pca`) when
-        ``config.uses_pca_init(n_conditions)``, else PyTorch's random initialisation (seeded by the
-        caller)."""
+        :class:`~meshvae_lib.model.train_config.TrainConfig` whose ``latent_dim`` the trainer has
+        resolved): the PCA start (:meth:`from_pca`) when ``config.uses_pca_init(n_conditions)``, else
+        PyTorch's random initialisation (seeded by the caller). The mesh is not needed (the rows are
+        all it reads)."""
         if config.uses_pca_init(n_conditions):
             return cls.from_pca(x, config, n_conditions)
-        return cls(x.shape[1], config.resolved_latent_dim(x.shape[0], n_conditions), config.hidden, n_conditions,
+        return cls(x.shape[1], _latent(config, x.shape[0], n_conditions), config.hidden, n_conditions,
                    sigma_floor=config.sigma_floor, output=config.output)
 
     @classmethod
@@ -181,7 +187,7 @@ class MeshVAE(nn.Module):
         """A network without internal layers whose decoded means start as the training rows' PCA.
 
         x : (N, K) float32 normalised training rows (N >= 2); config : the latent size
-        (``config.resolved_latent_dim(N)``), alpha and sigma_floor come from it (``config.hidden``
+        (``config.latent_dim``, resolved by the trainer), alpha and sigma_floor come from it (``config.hidden``
         must be empty, ``config.output`` "tanh"). The
         input projection, encoder and decoder start as :func:`~meshvae_lib.model.pca_start.pca_start`
         says (the deviation is 1 in the latent dimensions beyond its rank, where the latent cost is
@@ -191,7 +197,7 @@ class MeshVAE(nn.Module):
             raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
         if config.output != "tanh":
             raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
-        D = config.resolved_latent_dim(x.shape[0], n_conditions)
+        D = _latent(config, x.shape[0], n_conditions)
         start = pca_start(x.detach().double().cpu().numpy(), D, config.alpha)
         r = start.rank
         net = cls(x.shape[1], D, (), n_conditions, input_rank=r, sigma_floor=config.sigma_floor)
@@ -303,6 +309,13 @@ class MeshVAE(nn.Module):
         return self.decode(z, c), mu, sigma
 
 
+def _latent(config, n_rows: int, n_conditions: int) -> int:
+    """The latent size of a new network: the one rule,
+    :meth:`~meshvae_lib.model.train_config.TrainConfig.resolved_latent_dim` (the trainer has already
+    applied it; a start called directly applies it here)."""
+    return config.resolved_latent_dim(n_rows, n_conditions)
+
+
 def kl_divergence(
     mu: torch.Tensor, sigma: torch.Tensor, sigma_object: torch.Tensor | None = None, form: str = "exact"
 ) -> torch.Tensor:
@@ -356,11 +369,12 @@ def vae_loss(
     """Mesh VAE loss (Eq. 4; Eq. 5 for the conditional model, whose prior does not depend on c).
 
     x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D); sigma_object and
-    prior_form : see :func:`kl_divergence`; loss : the reconstruction term, "mse" (the paper's) or
+    prior_form : see :func:`kl_divergence`; loss : the reconstruction term, "mse" (the paper's),
     "bce" (binary cross-entropy of a sigmoid output against targets in [0, 1] -- others are clipped --,
-    summed over the K components and averaged over the meshes, as DRAW; alpha is not used; Sec. 5.1).
+    summed over the K components and averaged over the meshes, as DRAW; alpha is not used; Sec. 5.1)
+    or "l1" (SpiralNet++'s: alpha/(MK) sum |x_hat - x|).
     Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2 (or
-    the cross-entropy), ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise),
+    the cross-entropy, or the L1 term), ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise),
     and ``mse`` = mean squared error per component (for logging; alpha-free).
     """
     if x_hat.shape != x.shape or x.ndim != 2:
@@ -371,6 +385,9 @@ def vae_loss(
         # targets beyond [0, 1] (held-out rows outside the training range) are clipped: BCE needs [0, 1]
         reconstruction = torch.nn.functional.binary_cross_entropy(x_hat, x.clamp(0.0, 1.0), reduction="sum") / x.shape[0]
         mse = torch.nn.functional.mse_loss(x_hat.detach(), x)
+    elif loss == "l1":
+        mse = torch.nn.functional.mse_loss(x_hat.detach(), x)
+        reconstruction = alpha * torch.nn.functional.l1_loss(x_hat, x)
     else:
         mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
         reconstruction = 0.5 * alpha * mse

@@ -18,8 +18,11 @@ __all__ = ["output_slope", "mesh_vae_decoder_jacobian"]
 
 
 def output_slope(output: str, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The output activation ``output`` ("tanh" or "sigmoid") at pre-activations ``y`` and its slope,
-    both float64 of y's shape."""
+    """The output activation ``output`` ("tanh", "sigmoid" or "linear") at pre-activations ``y`` and
+    its slope, both float64 of y's shape."""
+    if output == "linear":
+        y = np.asarray(y, dtype=np.float64)
+        return y.copy(), np.ones_like(y)
     if output == "sigmoid":
         r = 0.5 * (1.0 + np.tanh(0.5 * y))          # the logistic function, without overflow far out
         return r, r * (1.0 - r)

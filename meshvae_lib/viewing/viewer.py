@@ -283,17 +283,24 @@ class MeshViewer:
             which = list(range(self.n_meshes))
         P = Vs.astype(np.float32)
         N = np.asarray(vertex_normals(Vs, self.F), dtype=np.float32)
+        self.set_buffers(P, N, which)
+        self.n_updates += 1
+        self.last_update_ms = 1e3 * (time.perf_counter() - t0)
+
+    def set_buffers(self, P, N, which=None):
+        """Hand positions ``P`` and normals ``N`` ((len(which), n_vertices, 3) float32) of the meshes
+        ``which`` (default all) to the view as they are: the last stage of :meth:`update`, which
+        computes the normals first."""
+        which = list(range(self.n_meshes)) if which is None else list(which)
         for j, i in enumerate(which):
-            self.positions[i] = np.ascontiguousarray(P[j])
-            self.normals[i] = np.ascontiguousarray(N[j])
+            self.positions[i] = np.ascontiguousarray(P[j], dtype=np.float32)
+            self.normals[i] = np.ascontiguousarray(N[j], dtype=np.float32)
         if self.mode == "threejs":
             for i in which:
                 self._pos_attrs[i].array = self.positions[i]
                 self._nrm_attrs[i].array = self.normals[i]
         else:
             self._image.update(meshes=[p.astype(np.float64) for p in self.positions])
-        self.n_updates += 1
-        self.last_update_ms = 1e3 * (time.perf_counter() - t0)
 
     # -- static copies ---------------------------------------------------------------------------
     def figure(self, **render_kw):
