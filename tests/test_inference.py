@@ -10,7 +10,8 @@ from meshvae_lib.geometry.reconstruction import RIMDReconstructor
 from meshvae_lib.geometry.rimd import RIMDEncoder
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline, per_vertex_error
 from meshvae_lib.model.feature_kinds.coords import CoordinateLinearization
-from meshvae_lib.model.inference.gauss_newton import decoder_jacobian, gauss_newton_codes, rigid_fields
+from meshvae_lib.model.inference.gauss_newton import gauss_newton_codes, rigid_fields
+from meshvae_lib.model.networks import decoder_linearization as decoder_jacobian
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.vae import MeshVAE

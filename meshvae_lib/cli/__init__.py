@@ -283,6 +283,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def run() -> None:
+    """The ``meshvae`` console script and ``python -m meshvae_lib.cli``: :func:`main`, then exit with
+    its status. After a Ctrl-C has been reported (status 130), further interrupts are ignored: the
+    command is over, and a late second one (while the interpreter shuts down) must not turn the
+    status into a death by SIGINT or print a traceback."""
+    import signal
+
+    try:
+        status = main()
+    except KeyboardInterrupt:  # a second Ctrl-C while the first was being reported
+        print("meshvae: interrupted", file=sys.stderr)
+        status = EXIT_INTERRUPTED
+    if status == EXIT_INTERRUPTED:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.exit(status)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; returns its exit status (argparse errors, ``--help`` and ``--version``
     raise ``SystemExit`` as argparse does: 2 and 0; Ctrl-C returns ``EXIT_INTERRUPTED``)."""

@@ -1,20 +1,6 @@
-"""``python -m meshvae_lib.cli``: run one command and exit with its status.
+"""``python -m meshvae_lib.cli``: run one command and exit with its status (:func:`meshvae_lib.cli.run`,
+the same entry point as the ``meshvae`` console script)."""
 
-After a Ctrl-C has been reported (status 130), further interrupts are ignored: the command is over,
-and a late second one (while the interpreter shuts down) must not turn the status into a death by
-SIGINT or print a traceback.
-"""
+from meshvae_lib.cli import run
 
-import signal
-import sys
-
-from meshvae_lib.cli import EXIT_INTERRUPTED, main
-
-try:
-    status = main()
-except KeyboardInterrupt:  # a second Ctrl-C while the first was being reported
-    print("meshvae: interrupted", file=sys.stderr)
-    status = EXIT_INTERRUPTED
-if status == EXIT_INTERRUPTED:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-sys.exit(status)
+run()

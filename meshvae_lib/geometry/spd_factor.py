@@ -16,8 +16,6 @@ time (it slows sharply beyond about 16).
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
@@ -25,8 +23,6 @@ from scipy.sparse.linalg import splu
 from meshvae_lib.tolerances import SPARSE_SOLVE_CHUNK
 
 __all__ = ["SPDFactor", "factorize_spd", "pinning", "spd_backend"]
-
-logger = logging.getLogger(__name__)
 
 
 def spd_backend() -> str:

@@ -66,7 +66,7 @@ def decoder_column_norms(network, mu) -> np.ndarray:
     -------
     c : (N, D) float64 (or (D,) for one code)
     """
-    from meshvae_lib.model.networks import decoder_linearization as decoder_jacobian
+    from meshvae_lib.model.networks import decoder_linearization
 
     if network.n_conditions:
         raise ValueError("decoder_column_norms takes an unconditional network; this one has "
@@ -76,7 +76,7 @@ def decoder_column_norms(network, mu) -> np.ndarray:
     Z = mu[None] if single else mu
     if Z.ndim != 2 or Z.shape[1] != network.latent_dim:
         raise ValueError(f"mu must have shape (N, {network.latent_dim}), got {mu.shape}")
-    c = np.stack([np.linalg.norm(decoder_jacobian(network, z)[1], axis=0) for z in Z])
+    c = np.stack([np.linalg.norm(decoder_linearization(network, z)[1], axis=0) for z in Z])
     return c[0] if single else c
 
 

@@ -1,7 +1,7 @@
 """Semi-amortised inference (the default): the encoder's mean, then a few damped Gauss-Newton
 (Levenberg-Marquardt) steps on the decoded mesh's squared vertex error,
 ``min_z min_(R,t) sum_k |decode(z)_k - (R x_k + t)|^2``, with the **analytic** Jacobian of decoder
-and reconstruction: :func:`decoder_jacobian` (the network, then the affine maps of the output range
+and reconstruction: :func:`~meshvae_lib.model.networks.decoder_linearization` (the network, then the affine maps of the output range
 and Eq. 3) times the feature kind's linearisation (``FeatureKind.linearize``; for RIMD
 :mod:`~meshvae_lib.geometry.reconstruction_linearization`). One step costs one Jacobian (two
 factorised sparse solves per latent dimension) and usually one decode. On real collections the
@@ -29,14 +29,8 @@ from meshvae_lib.model.vae_linearization import output_slope
 from meshvae_lib.validation import check_count
 from meshvae_lib.workers import map_forked, resolve_jobs
 
-__all__ = ["GaussNewton", "decoder_jacobian", "rigid_fields", "without_rigid_motions", "GaussNewtonReport",
+__all__ = ["GaussNewton", "rigid_fields", "without_rigid_motions", "GaussNewtonReport",
            "gauss_newton_codes", "marquardt_fit", "MarquardtFit", "FitState", "LatentDecoder"]
-
-
-def decoder_jacobian(network, z: np.ndarray, c: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The network's decoded rows ``(K,)`` and their Jacobian ``(K, D)`` float64 at one code
-    (:func:`meshvae_lib.model.networks.decoder_linearization`: the network's closed form, or autograd)."""
-    return decoder_linearization(network, z, c)
 
 
 class GaussNewtonReport:
@@ -68,7 +62,7 @@ class LatentDecoder:
 
     A network whose decoder is one linear map and an activation (``linear_decoder()``, the default
     mesh VAE) is evaluated here in float64 on its used columns only; any other through
-    :func:`decoder_jacobian` at every state.
+    :func:`~meshvae_lib.model.networks.decoder_linearization` at every state.
 
     Attributes
     ----------
@@ -106,7 +100,7 @@ class LatentDecoder:
             rows, slope = output_slope(self.network.output, y)
             network_jacobian = None
         else:
-            rows, network_jacobian = decoder_jacobian(self.network, z, c)
+            rows, network_jacobian = decoder_linearization(self.network, z, c)
             slope = None
         return _DecodedState(self.kind.linearize(self.offset + self.scale * rows), x, slope, network_jacobian)
 
