@@ -195,6 +195,9 @@ def test_the_spiral_network_goes_through_every_path(features, tmp_path):
     model = MeshVAEModel(features, cfg, holdout_every=5).fit(coll)
     assert type(model.network).__name__ == "SpiralVAE" and isinstance(model.network, networks.Network)
     assert model.latent_dim == 3 and model.train_epochs_ == 400 and model.network.level_sizes[0] == 360
+    from meshvae_lib.course.display import model_summary
+
+    assert "network:  spiral, spiral convolutions 8 -> 8 (spirals of 7) on 360 -> " in model_summary(model)
     encoder = evaluate_model(model, coll, held_out_only=True, inference="encoder")
     default = evaluate_model(model, coll, held_out_only=True)                  # Gauss-Newton through autograd
     assert default["inference"] == "gauss-newton"

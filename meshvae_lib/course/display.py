@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvae_lib.defaults import DEFAULT_ARCHITECTURE
 from meshvae_lib.tolerances import TIE_RTOL
 
 __all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table",
@@ -159,7 +160,8 @@ def spiral_figure(records):
 def describe_model(model) -> dict:
     """What a fitted :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel` is, as plain values.
 
-    Returns a dict: ``features`` (the feature kind), ``n_features`` (K), ``latent_dim`` (D),
+    Returns a dict: ``architecture`` (the network's registry name), ``network`` (what it is, in a few
+    words: the network's ``describe()`` where it has one), ``features`` (the feature kind), ``n_features`` (K), ``latent_dim`` (D),
     ``used_dims`` (dimensions the decoder uses), ``hidden`` (internal layer sizes, outermost first;
     empty: one linear map each way), ``conditions`` (number of condition inputs), ``sigma_object``
     (True when a sigma_object prior was trained), ``start`` ("PCA" or "random"), ``epoch_budget``
@@ -174,7 +176,10 @@ def describe_model(model) -> dict:
     config = model.train_config_
     n_cond = int(model.n_conditions)
     history = model.history_
+    net = model.network
     return {
+        "architecture": str(config.architecture),
+        "network": net.describe() if callable(getattr(net, "describe", None)) else type(net).__name__,
         "features": str(model.features),
         "n_features": int(model.n_features),
         "latent_dim": int(model.latent_dim),
@@ -199,6 +204,8 @@ def model_summary(model) -> str:
     d = describe_model(model)
     layers = "no internal layer (one linear map each way)" if not d["hidden"] else \
         "internal layers " + " -> ".join(str(h) for h in d["hidden"])
+    if d["architecture"] != DEFAULT_ARCHITECTURE:
+        layers = f"{d['architecture']}, {d['network']}"
     extras = [f"{d['conditions']} condition inputs"] * bool(d["conditions"]) + ["a sigma_object prior"] * d["sigma_object"]
     start = "the PCA of the training features" if d["start"] == "PCA" else "random weights (PyTorch's initialisation)"
     chosen = ("no epoch search: the start's span holds every training row" if d["search_skipped"] else

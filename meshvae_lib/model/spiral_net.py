@@ -139,6 +139,11 @@ class SpiralVAE(nn.Module):
                     getattr(net, f"{name}_{level}_value").copy_(torch.from_numpy(m.data.astype(np.float32)))
         return net
 
+    def describe(self) -> str:
+        """The network in a few words (for summaries)."""
+        return (f"spiral convolutions {' -> '.join(map(str, self.channels))} (spirals of {self.spiral_length}) on"
+                f" {' -> '.join(map(str, self.level_sizes))} vertices, a linear output")
+
     def used_latent_dims(self) -> np.ndarray:
         """Every latent dimension (a nonlinear decoder reads them all)."""
         return np.arange(self.latent_dim)

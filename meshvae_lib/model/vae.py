@@ -216,6 +216,11 @@ class MeshVAE(nn.Module):
             net.decoder_head.bias.copy_(f32(start.decoder_bias))
         return net
 
+    def describe(self) -> str:
+        """The network in a few words (for summaries)."""
+        layers = " -> ".join(map(str, self.hidden)) if self.hidden else "no internal layer"
+        return f"fully connected, {layers}, a {self.output} output"
+
     def used_latent_dims(self) -> np.ndarray:
         """Indices (int64) of the latent dimensions the decoder reads: with no internal layer, those
         whose column of the decoder's weight exceeds ``GN_UNUSED_DIM_RTOL`` of the largest column
