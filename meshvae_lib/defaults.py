@@ -46,6 +46,9 @@ SIGMA_MAX = 2.0
 DEFAULT_ALPHA = 1e6
 #: default latent size (the paper's).
 DEFAULT_LATENT = 128
+#: the course's small latent size (06's plain and conditional models, 08's exploration model): the
+#: smallest of the paper's Table 1.
+COURSE_SMALL_LATENT = 16
 #: a PCA-started network's default latent size grows beyond DEFAULT_LATENT to the N - 1 directions its N
 #: training meshes span, up to this many (``TrainConfig.resolved_latent_dim``). Measured on the full
 #: real collections (140-164 training meshes): with 128 dimensions even the training meshes came back

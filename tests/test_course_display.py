@@ -83,7 +83,8 @@ def test_span_ceiling_table_prints_the_recorded_errors_and_their_ratios_to_pca()
 
 
 def _spiral_record(name, source, pca, spiral, rimd, default, used):
-    net = lambda enc, gn, u=16: {"used": u, "train_seconds": 1.0, "encoder": {"error": enc}, "gauss_newton": {"error": gn}}  # noqa: E731
+    net = lambda enc, gn, u=16: {"used": u, "train_seconds": 1.0, "encoder": {"error": enc},  # noqa: E731
+                                 "gauss_newton": {"error": gn, "n_meshes": 14}}
     return {"collection": name, "source": source, "vertices": 2514, "latent": 16, "pca": pca, "pca_all": pca / 3,
             "spiral": net(*spiral), "rimd_equal": net(*rimd), "rimd_default": net(default, default, used)}
 
@@ -97,8 +98,8 @@ def test_spiral_table_and_figure_show_each_network_beside_pca_at_one_latent_size
     records = [_spiral_record("scape", "synthetic stand-in", 0.04, (0.06, 0.05), (0.045, 0.02), 0.002, 56),
                _spiral_record("pcow/3", "real", 0.07, (0.15, 0.1), (0.1, 0.035), 0.014, 54)]
     lines = spiral_table(records).splitlines()
-    assert len(lines) == 3 and lines[0].split()[:3] == ["collection", "verts", "D"]
-    assert lines[1].split() == ["scape", "(stand-in)", "2514", "16", "4.00e-02", "6.00e-02", "5.00e-02", "4.50e-02",
+    assert len(lines) == 3 and lines[0].split()[:4] == ["collection", "verts", "held", "D"]
+    assert lines[1].split() == ["scape", "(stand-in)", "2514", "14", "16", "4.00e-02", "6.00e-02", "5.00e-02", "4.50e-02",
                                 "2.00e-02", "2.00e-03", "(", "56)", "|", "1.25,", "0.50"]
     assert lines[2].split()[:2] == ["pcow/3", "(real)"] and lines[2].split()[-2:] == ["1.43,", "0.50"]
     fig = spiral_figure(records)

@@ -124,15 +124,16 @@ def spiral_table(records) -> str:
     collection with ``collection``, ``source``, ``vertices``, ``latent`` D, ``pca`` (PCA on
     coordinates with D directions), ``pca_all`` (with every direction), and ``spiral``, ``rimd_equal``
     (RIMD at latent D), ``rimd_default`` (RIMD, latent resolved: more than D used dimensions), each
-    with ``used``, ``train_seconds`` and the ``encoder`` and ``gauss_newton`` errors) as a
-    fixed-width table; the default's column says how many dimensions it used. Recorded numbers, the
+    with ``used``, ``train_seconds`` and the ``encoder`` and ``gauss_newton`` errors and
+    ``n_meshes``) as a fixed-width table ("held": the held-out meshes measured); the default's column says how many dimensions it used. Recorded numbers, the
     same on every machine."""
-    head = f"{'collection':22s} {'verts':>6s} {'D':>3s} " + " ".join(f"{label:>12s}" for _, _, label in _SPIRAL_COLUMNS)
+    head = f"{'collection':22s} {'verts':>6s} {'held':>4s} {'D':>3s} " + " ".join(f"{label:>12s}" for _, _, label in _SPIRAL_COLUMNS)
     lines = [head + "  (dims of the default) | spiral GN / PCA, RIMD GN / PCA"]
     for r in records:
         cells = [_spiral_cell(r, k, h) for k, h, _ in _SPIRAL_COLUMNS]
         name = f"{r['collection']} ({'real' if r['source'] == 'real' else 'stand-in'})"
-        lines.append(f"{name:22s} {r['vertices']:6d} {r['latent']:3d} " + " ".join(f"{c:12.2e}" for c in cells)
+        held = r["spiral"]["gauss_newton"]["n_meshes"]
+        lines.append(f"{name:22s} {r['vertices']:6d} {held:4d} {r['latent']:3d} " + " ".join(f"{c:12.2e}" for c in cells)
                      + f"  ({r['rimd_default']['used']:3d})             | {cells[2] / cells[0]:6.2f}, {cells[4] / cells[0]:6.2f}")
     return "\n".join(lines)
 

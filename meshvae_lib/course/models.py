@@ -29,8 +29,9 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 from meshvae_lib.course.closure import closure_fingerprint
-from meshvae_lib.defaults import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, DEFAULT_FEATURE_KIND, EMBEDDING_ALPHA,
-                                  EMBEDDING_HIDDEN, EMBEDDING_SEEDS, EMBEDDING_SIGMA_OBJECT, EXPLORATION_SIGMA_OBJECT)
+from meshvae_lib.defaults import (CONDITIONAL_ALPHA, CONDITIONAL_HIDDEN, COURSE_SMALL_LATENT, DEFAULT_FEATURE_KIND,
+                                  DEFAULT_LATENT, EMBEDDING_ALPHA, EMBEDDING_HIDDEN, EMBEDDING_SEEDS,
+                                  EMBEDDING_SIGMA_OBJECT, EXPLORATION_SIGMA_OBJECT)
 from meshvae_lib.model.train_config import pad_sigma_object
 
 logger = logging.getLogger(__name__)
@@ -93,7 +94,7 @@ _PLAIN_BODIES = CourseModelSpec(
     description="5 bodies x 7 motions x 6 frames, 1,584 vertices, all meshes; the library's defaults, latent 16",
     minutes=0.2,
     holdout_every=0,
-    config={"epochs": 1000, "latent_dim": 16, "batch_size": 32, "seed": 0},
+    config={"epochs": 1000, "latent_dim": COURSE_SMALL_LATENT, "batch_size": 32, "seed": 0},
 )
 
 #: 07's models: the sigma_object prior (0.1 for dims 1-2, 1 for the rest) on 06's collection, once
@@ -105,8 +106,8 @@ _EMBEDDING_BODIES = replace(
     description="06's collection; sigma_object 0.1 for dims 1-2 (sibling form), alpha 1e3, a hidden layer of 256, "
                 "latent 128, 153 epochs (918 Adam steps: 6 batches of 35 meshes)",
     minutes=0.5,
-    config={"epochs": 153, "latent_dim": 128, "batch_size": 32, "alpha": EMBEDDING_ALPHA, "hidden": EMBEDDING_HIDDEN,
-            "sigma_object": tuple(float(s) for s in pad_sigma_object(EMBEDDING_SIGMA_OBJECT, 128)), "prior_form": "sibling", "seed": 0},
+    config={"epochs": 153, "latent_dim": DEFAULT_LATENT, "batch_size": 32, "alpha": EMBEDDING_ALPHA, "hidden": EMBEDDING_HIDDEN,
+            "sigma_object": tuple(float(s) for s in pad_sigma_object(EMBEDDING_SIGMA_OBJECT, DEFAULT_LATENT)), "prior_form": "sibling", "seed": 0},
 )
 _EMBEDDING_ABLATIONS = (
     replace(_EMBEDDING_BODIES, name="embedding-bodies-exact-kl",
@@ -127,7 +128,7 @@ COURSE_MODELS: dict[str, CourseModelSpec] = {
             resolution=2100,
             description="one body in 71 poses, 2,107 vertices, every 5th held out; the library's defaults, latent 128",
             minutes=1.0,
-            config={"epochs": 1000, "latent_dim": 128, "batch_size": 16, "seed": 0},
+            config={"epochs": 1000, "latent_dim": DEFAULT_LATENT, "batch_size": 16, "seed": 0},
         ),
         _PLAIN_BODIES,
         replace(
@@ -150,8 +151,8 @@ COURSE_MODELS: dict[str, CourseModelSpec] = {
                         "a hidden layer of 256, 1000 epochs",
             minutes=2.0,
             holdout_every=0,
-            config={"epochs": 1000, "latent_dim": 16, "batch_size": 16, "alpha": EMBEDDING_ALPHA,
-                    "hidden": EMBEDDING_HIDDEN, "sigma_object": tuple(float(s) for s in pad_sigma_object(EXPLORATION_SIGMA_OBJECT, 16)),
+            config={"epochs": 1000, "latent_dim": COURSE_SMALL_LATENT, "batch_size": 16, "alpha": EMBEDDING_ALPHA,
+                    "hidden": EMBEDDING_HIDDEN, "sigma_object": tuple(float(s) for s in pad_sigma_object(EXPLORATION_SIGMA_OBJECT, COURSE_SMALL_LATENT)),
                     "prior_form": "sibling", "seed": 0},
         ),
     )
