@@ -150,6 +150,8 @@ def spiral_figure(records):
         ax.bar(np.arange(len(records)) + (j - (len(_SPIRAL_COLUMNS) - 1) / 2) * width, values, width, label=label,
                color=f"C{j}", hatch="//" if key == "rimd_default" else None, edgecolor="white" if key == "rimd_default" else None)
     ax.set_yscale("log")
+    every = [_spiral_cell(r, k, h) for r in records for k, h, _ in _SPIRAL_COLUMNS]
+    ax.set_ylim(min(every) / 2, max(every) * 6)  # room for the legend above the bars
     ax.set_xticks(np.arange(len(records)), [f"{r['collection']}\n{r['vertices']:,} vertices" for r in records])
     ax.set_ylabel("held-out mean vertex error")
     ax.set_title(f"latent size D = {records[0]['latent']} (the hatched default uses more)")
