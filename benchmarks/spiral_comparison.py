@@ -30,23 +30,18 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from meshvae_lib.geometry.collection import MeshCollection
+from feature_comparison import SHARED_DATA, load_real
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
 from meshvae_lib.model.meshvae_model import MeshVAEModel
 from meshvae_lib.model.train_config import TrainConfig
-
-SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 
 def load(name: str) -> tuple[object, str]:
     """``name`` = a real collection of ../shared/data, optionally ``/k`` (every k-th frame), or a
     data_synth collection."""
     base, _, k = name.partition("/")
-    step = int(k or 1)
-    path = SHARED_DATA / f"{base}.npz"
-    if path.exists():
-        d = np.load(path)
-        return MeshCollection(np.asarray(d["vertices"], np.float64)[::step], np.asarray(d["faces"])), "real"
+    if (SHARED_DATA / f"{base}.npz").exists():
+        return load_real(base, int(k or 1)), "real"
     from data_synth.registry import make_collection
 
     return make_collection(base, seed=0), "synthetic stand-in"
