@@ -25,11 +25,10 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 
 import numpy as np
-import torch
 
+from collection_records import add_record_options, run_collections
 from feature_comparison import SHARED_DATA, load_real
 from meshvae_lib.model.evaluation import evaluate_model, pca_baseline
 from meshvae_lib.model.meshvae_model import MeshVAEModel
@@ -107,20 +106,8 @@ def main(argv=None) -> int:
     p.add_argument("--latent", type=int, default=16)
     p.add_argument("--holdout-every", type=int, default=5)
     p.add_argument("--first", type=int, default=None, help="evaluate only the first this-many held-out meshes")
-    p.add_argument("--threads", type=int, default=1)
-    p.add_argument("--out", type=Path, default=None, help="append the records to this JSON file")
-    p.add_argument("--table", type=Path, default=None, help="print the markdown table of this JSON file and stop")
-    args = p.parse_args(argv)
-    if args.table is not None:
-        print(markdown(json.loads(args.table.read_text())))
-        return 0
-    torch.set_num_threads(args.threads)
-    for name in args.collections:
-        rec = run(name, args)
-        if args.out is not None:
-            old = json.loads(args.out.read_text()) if args.out.exists() else []
-            args.out.write_text(json.dumps([*[o for o in old if o["collection"] != name], rec], indent=1) + "\n")
-    return 0
+    add_record_options(p)
+    return run_collections(p.parse_args(argv), run, markdown)
 
 
 if __name__ == "__main__":

@@ -62,6 +62,14 @@ SPIRAL_LENGTH = 9
 SPIRAL_DOWNSAMPLING = (4, 4, 4, 4)
 SPIRAL_LATENT = 16
 SPIRAL_EPOCHS = 300
+#: the local-parts network's defaults (``local_parts.LocalPartsVAE``): regions of the reference mesh,
+#: the rule that finds them (``geometry.regions.REGION_METHODS``) and the latent size (the paper's,
+#: LOCAL_PARTS_LATENT / LOCAL_PARTS_REGIONS dimensions a region; docs/vae.md, "A decoder of local parts").
+LOCAL_PARTS_REGIONS = 4
+#: the rules that find regions (``geometry.regions.mesh_regions``) and the local-parts network's.
+REGION_METHODS = ("kmeans", "spectral")
+LOCAL_PARTS_METHOD = "spectral"
+LOCAL_PARTS_LATENT = 128
 #: Adam learning rate.
 DEFAULT_LR = 1e-3
 #: slope of the leaky ReLU on internal layers.

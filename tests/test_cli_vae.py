@@ -228,3 +228,24 @@ def test_train_a_spiral_network_from_the_command_line(tmp_path, capsys):
     assert main(["train", str(small), "-o", str(tmp_path / "y.pt"), "--architecture", "spiral", "--epochs", "1",
                  "--no-progress"]) == 2
     assert "too few for down-sampling" in capsys.readouterr().err
+
+
+def test_train_a_local_parts_network_from_the_command_line(tmp_path, capsys):
+    """--architecture local-parts with --regions and --region-method; its options are refused for the
+    other networks, and a latent size that does not split into the regions before any data is read."""
+    coll = _strips(n=10)
+    path = write_collection(tmp_path / "s.npz", coll)
+    out = tmp_path / "parts.pt"
+    assert main(["train", str(path), "-o", str(out), "--architecture", "local-parts", "--regions", "2", "--latent", "4",
+                 "--region-method", "kmeans", "--holdout-every", "5", "--no-progress"]) == 0
+    text = capsys.readouterr()
+    assert "network local-parts, features rimd" in text.err + text.out and "held-out per-vertex error" in text.out
+    m = load_model(out, coll)
+    assert type(m.network).__name__ == "LocalPartsVAE" and m.network.n_regions == 2 and m.latent_dim == 4
+    assert sorted(set(m.network.vertex_region.tolist())) == [0, 1]
+    for bad, why in ((["--architecture", "local-parts", "--regions", "3", "--latent", "4"], "not a multiple of --regions 3"),
+                     (["--regions", "2"], "local-parts network's"),
+                     (["--architecture", "local-parts", "--regions", "0"], "--regions")):
+        capsys.readouterr()
+        assert main(["train", str(tmp_path / "missing.npz"), "-o", str(tmp_path / "x.pt"), *bad]) == 2
+        assert why in capsys.readouterr().err

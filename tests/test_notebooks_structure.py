@@ -20,9 +20,9 @@ NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
 NOISE = re.compile(r"Warning|warn\(|DEPRECAT|Traceback|INFO:|DEBUG:", re.IGNORECASE)
 
 
-def test_the_course_has_its_eleven_numbered_notebooks():
+def test_the_course_has_its_twelve_numbered_notebooks():
     numbers = [p.name[:2] for p in NOTEBOOKS]
-    assert numbers == [f"{i:02d}" for i in range(11)], [p.name for p in NOTEBOOKS]
+    assert numbers == [f"{i:02d}" for i in range(12)], [p.name for p in NOTEBOOKS]
     for p in NOTEBOOKS:
         assert re.fullmatch(r"\d\d_[a-z0-9_]+\.ipynb", p.name), p.name
 

@@ -13,8 +13,13 @@ typical distance between a training mesh and its nearest *other* training mesh
 (``dataset_nn_distance``): a generated mesh much closer to a training mesh than that would be a
 copy.
 
+A decoder of local parts (:class:`~meshvae_lib.model.local_parts.LocalPartsVAE`) also generates by
+mixing parts (``mix_parts``): each region's latent dimensions taken from the code of a training
+mesh drawn for that region, so the new mesh has this pose's arm and that pose's legs (the paper's
+reading of its Fig. 2).
+
 Public names: ``nearest_training_meshes``, ``GenerationResult``, ``nearest_neighbors``,
-``dataset_feature_rows``, ``condition_agreement``. (Meshes alone, without the comparison:
+``dataset_feature_rows``, ``condition_agreement``, ``mix_parts``. (Meshes alone, without the comparison:
 ``MeshVAEModel.generate``; prior draws: ``MeshVAEModel.sample_latent``.)
 """
 
@@ -29,7 +34,7 @@ from meshvae_lib.tolerances import DUPLICATE_DISTANCE_RTOL
 from meshvae_lib.validation import check_choice, check_count, check_vertices
 
 __all__ = ["nearest_neighbors", "dataset_feature_rows", "nearest_training_meshes", "GenerationResult",
-           "condition_agreement", "FEATURE_SPACES"]
+           "condition_agreement", "mix_parts", "FEATURE_SPACES"]
 
 #: the spaces nearest neighbours are searched in: RIMD features in the paper's layout (Sec. 5.2's
 #: distance, whatever the model's own features and layout), or the model's own feature rows.
@@ -237,3 +242,39 @@ def condition_agreement(model, dataset, column: str, values=None, n: int = 10, s
                                       dataset_features=X)
         hits.append(float(np.mean(res.nearest_labels[column] == v)))
     return np.asarray(hits)
+
+
+def mix_parts(codes, latent_region, n: int, seed: int = 0, neighbours: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """New codes that mix the parts of given ones: region by region, the dimensions of a code drawn at random.
+
+    codes : (M, D) float, e.g. the training meshes' codes; latent_region : (D,) int, the region of
+    each latent dimension (a local-parts network's ``latent_region``); n : codes to make; seed : the
+    draws' seed; neighbours : None (default) draws every region's source among all M codes; k draws
+    a base code, then every region's source among the base's k nearest codes (Euclidean, the base
+    included): parts of similar poses, as a new pose of the same motion combines them.
+
+    Returns ``(z (n, D) float64, sources (n, R) int64)``: ``z[i]``'s dimensions of the r-th region
+    (in increasing region number) are those of ``codes[sources[i, r]]``.
+    """
+    Z = np.asarray(codes, dtype=np.float64)
+    labels = np.asarray(latent_region)
+    if Z.ndim != 2 or labels.shape != (Z.shape[1],) or len(Z) < 1:
+        raise ValueError(f"codes must be (M >= 1, D) and latent_region (D,), got {Z.shape} and {labels.shape}")
+    n = check_count(n, "n", minimum=1)
+    regions = np.unique(labels)
+    rng = np.random.default_rng(seed)
+    if neighbours is None:
+        sources = rng.integers(0, len(Z), size=(n, len(regions)))
+    else:
+        k = check_count(neighbours, "neighbours", minimum=1)
+        if k > len(Z):
+            raise ValueError(f"neighbours must be at most the {len(Z)} codes, got {k}")
+        base = rng.integers(0, len(Z), size=n)
+        d2 = np.sum((Z[base][:, None, :] - Z[None, :, :]) ** 2, axis=-1)  # (n, M)
+        near = np.argsort(d2, axis=1, kind="stable")[:, :k]
+        sources = np.take_along_axis(near, rng.integers(0, k, size=(n, len(regions))), axis=1)
+    z = np.empty((n, Z.shape[1]))
+    for r, g in enumerate(regions):  # a loop over the regions (a handful)
+        cols = np.flatnonzero(labels == g)
+        z[:, cols] = Z[sources[:, r]][:, cols]
+    return z, sources

@@ -9,6 +9,7 @@ import re
 from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
 from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS, SPIRAL_EPOCHS, SPIRAL_LATENT
+from meshvae_lib.defaults import LOCAL_PARTS_LATENT, LOCAL_PARTS_METHOD, LOCAL_PARTS_REGIONS, REGION_METHODS
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from meshvae_lib.model.networks import ARCHITECTURE_NAMES
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
@@ -122,6 +123,20 @@ def _network_choices(args) -> tuple[int, ...]:
     return ()
 
 
+def _network_options(args) -> dict:
+    """``TrainConfig.network_options`` from ``--regions`` and ``--region-method`` (local-parts only)."""
+    opts = {k: v for k, v in (("n_regions", args.regions), ("method", args.region_method)) if v is not None}
+    if opts and args.architecture != "local-parts":
+        raise UsageError(f"--regions and --region-method are the local-parts network's, not {args.architecture}'s")
+    if args.regions is not None:
+        check_at_least(args.regions, 1, "--regions")
+    if args.architecture == "local-parts":
+        latent, regions = args.latent or LOCAL_PARTS_LATENT, args.regions or LOCAL_PARTS_REGIONS
+        if latent % regions:
+            raise UsageError(f"--latent {latent} is not a multiple of --regions {regions} (each region gets as many dimensions)")
+    return opts
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
@@ -133,7 +148,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--architecture", choices=ARCHITECTURE_NAMES, default=DEFAULT_ARCHITECTURE,
                    help=f"the network: the paper's fully connected mesh VAE ({DEFAULT_ARCHITECTURE}, default) or a"
                         f" spiral-convolution network on vertex positions (spiral: SpiralNet++'s settings, latent {SPIRAL_LATENT},"
-                        f" {SPIRAL_EPOCHS} epochs, L1 loss)")
+                        f" {SPIRAL_EPOCHS} epochs, L1 loss) or a decoder of local parts (local-parts: --regions regions of"
+                        f" the mesh, latent {LOCAL_PARTS_LATENT} shared among them, each region's PCA)")
+    p.add_argument("--regions", type=int, default=None, metavar="R",
+                   help=f"local-parts: regions of the mesh (default {LOCAL_PARTS_REGIONS}; the latent size must be a multiple)")
+    p.add_argument("--region-method", choices=REGION_METHODS, default=None,
+                   help=f"local-parts: how regions are found (default {LOCAL_PARTS_METHOD}; spectral: k-means on the"
+                        " mesh graph Laplacian's eigenvectors, regions that follow the surface; kmeans: on the vertex positions)")
     p.add_argument("--latent", type=int, default=None, metavar="D",
                    help=f"latent size (default {DEFAULT_LATENT}, or with the PCA start one per direction the training"
                         f" meshes span when that is more, up to {PCA_LATENT_MAX})")
@@ -194,8 +215,9 @@ def run(args) -> int:
     _check_device(args.device)
     check_output(args.output, parents=True)  # model.save creates missing folders
     hidden = _network_choices(args)
+    options = _network_options(args)
     try:
-        config = TrainConfig(architecture=args.architecture, epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
+        config = TrainConfig(architecture=args.architecture, network_options=options, epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
                              latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
                              prior_form=args.prior_form, seed=args.seed, init=args.init,
                              early_stopping=False if args.no_early_stopping else None,

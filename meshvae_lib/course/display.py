@@ -13,7 +13,7 @@ from meshvae_lib.defaults import DEFAULT_ARCHITECTURE
 from meshvae_lib.tolerances import TIE_RTOL
 
 __all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table",
-           "spiral_table", "spiral_figure", "describe_model", "model_summary"]
+           "spiral_table", "spiral_figure", "local_parts_table", "local_parts_figure", "describe_model", "model_summary"]
 
 #: the columns of :func:`spiral_table` and :func:`spiral_figure`: (record key, inference, label).
 _SPIRAL_COLUMNS = (("pca", None, "PCA coords"), ("spiral", "encoder", "spiral enc"),
@@ -156,6 +156,61 @@ def spiral_figure(records):
     ax.set_ylabel("held-out mean vertex error")
     ax.set_title(f"latent size D = {records[0]['latent']} (the hatched default uses more)")
     ax.legend(ncol=3, fontsize=8, frameon=False)
+    fig.tight_layout()
+    return fig
+
+
+#: the columns of :func:`local_parts_table` and :func:`local_parts_figure`: (label, value of a record and variant).
+_LOCAL_COLUMNS = (("local parts", lambda r, v: v["error"]), ("regional PCA", lambda r, v: v["regional_pca"]),
+                  ("global RIMD", lambda r, v: r.get("default_equal", r["default"])["error"]),
+                  ("global PCA", lambda r, v: r["pca"]))
+
+
+def local_parts_table(records, variant: str) -> str:
+    """The local-parts network beside its linear floors and the global default, recorded
+    (``docs/results/local_parts.json``, written by ``benchmarks/local_parts_comparison.py``: one dict
+    per collection with ``collection``, ``source``, ``vertices``, ``n_evaluated``, ``latent``,
+    ``pca`` (PCA on coordinates with ``pca_directions``), ``default`` (the global RIMD default:
+    ``error``, ``used``), ``default_equal`` (the same network at ``latent``, present where the
+    default has more dimensions) and ``variants``: ``"R:rule"`` -> ``error`` and ``regional_pca`` (PCA
+    on coordinates with the same regions and directions)) for one ``variant``, as a fixed-width table
+    of held-out mean vertex errors (the global RIMD column at equal capacity: ``default_equal`` where
+    present, else the default) with the local model's ratios to each other column. Recorded numbers,
+    the same on every machine."""
+    head = f"{'collection':22s} {'verts':>6s} {'held':>4s} " + " ".join(f"{label:>14s}" for label, _ in _LOCAL_COLUMNS)
+    lines = [head + "   local / regional PCA, / global RIMD, / global PCA"]
+    for r in records:
+        v = r["variants"][variant]
+        cells = [f(r, v) for _, f in _LOCAL_COLUMNS]
+        name = f"{r['collection']} ({'real' if r['source'] == 'real' else 'stand-in'})"
+        dims = [str(v["used"]), str(v["regional_pca_directions"]), str(r.get("default_equal", r["default"])["used"]),
+                str(r["pca_directions"])]
+        lines.append(f"{name:22s} {r['vertices']:6d} {r['n_evaluated']:4d} "
+                     + " ".join(f"{c:9.2e} ({d:>3s})" for c, d in zip(cells, dims))
+                     + "   " + ", ".join(f"{cells[0] / c:5.2f}" for c in cells[1:]))
+    return "\n".join(lines) + "\n(in brackets: latent dimensions or principal directions used)"
+
+
+def local_parts_figure(records, variant: str):
+    """Grouped bars of :func:`local_parts_table` (log scale, one group per collection). Returns the
+    matplotlib figure."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9.5, 3.4))
+    width = 0.8 / len(_LOCAL_COLUMNS)
+    every = []
+    for j, (label, f) in enumerate(_LOCAL_COLUMNS):
+        values = [f(r, r["variants"][variant]) for r in records]
+        every += values
+        ax.bar(np.arange(len(records)) + (j - (len(_LOCAL_COLUMNS) - 1) / 2) * width, values, width, label=label,
+               color=f"C{j}")
+    ax.set_yscale("log")
+    ax.set_ylim(min(every) / 2, max(every) * 6)  # room for the legend above the bars
+    ax.set_xticks(np.arange(len(records)), [f"{r['collection']}{'' if r['source'] == 'real' else ' (stand-in)'}"
+                                            f"\n{r['vertices']:,} vertices" for r in records])
+    ax.set_ylabel("held-out mean vertex error")
+    ax.set_title(f"latent size {records[0]['latent']}: {variant.replace(':', ' regions, ')}")
+    ax.legend(ncol=4, fontsize=8, frameon=False)
     fig.tight_layout()
     return fig
 

@@ -18,7 +18,7 @@ from meshvae_lib.model.inference import make_inference
 from meshvae_lib.tolerances import PCA_RANK_RTOL
 from meshvae_lib.validation import check_is_fitted, check_vertices
 
-__all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline"]
+__all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline", "regional_pca_baseline"]
 
 
 def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
@@ -208,3 +208,37 @@ def pca_baseline(V_train, V_eval, n_components: int | None = None, aligned: bool
         "n_meshes": int(len(Ve)),
         "per_mesh": [float(e) for e in err],
     }
+
+
+def regional_pca_baseline(V_train, V_eval, vertex_region, per_region: int) -> dict:
+    """PCA on coordinates region by region: the linear floor of a decoder of local parts at its capacity.
+
+    V_train : (N, n, 3) float training meshes; V_eval : (M, n, 3) float meshes to reconstruct;
+    vertex_region : (n,) int, the region of each vertex (e.g. a local-parts network's
+    ``vertex_region``); per_region : principal directions kept in each region (fewer where the
+    region's training coordinates span fewer). Each region's coordinates are projected onto their
+    own directions (regions share no coordinate, so this is the orthogonal projection onto the
+    regions' directions together).
+
+    Returns a dict as :func:`pca_baseline`'s (``mean_vertex_error``, ``relative_error``,
+    ``n_components``: the directions used in all, ``n_meshes``, ``per_mesh``).
+    """
+    Vt = check_vertices(V_train, "V_train", batch=True)
+    Ve = check_vertices(V_eval, "V_eval", batch=True)
+    labels = np.asarray(vertex_region, dtype=np.int64)
+    if labels.shape != (Vt.shape[1],) or Ve.shape[1] != Vt.shape[1]:
+        raise ValueError(f"vertex_region must be ({Vt.shape[1]},) for meshes of {Vt.shape[1]} vertices, got"
+                         f" {labels.shape} and meshes of {Ve.shape[1]}")
+    out, used = np.empty_like(Ve), 0
+    for g in np.unique(labels):
+        idx = np.flatnonzero(labels == g)
+        X, Y = Vt[:, idx].reshape(len(Vt), -1), Ve[:, idx].reshape(len(Ve), -1)
+        mean = X.mean(axis=0)
+        _, s, W = np.linalg.svd(X - mean, full_matrices=False)
+        k = min(int(per_region), int(np.sum(s > s[0] * PCA_RANK_RTOL)) if s.size and s[0] > 0 else 0)
+        W, used = W[:k], used + k
+        out[:, idx] = (mean + (Y - mean) @ W.T @ W).reshape(len(Ve), len(idx), 3)
+    err = np.atleast_1d(per_vertex_error(out, Ve))
+    diag = np.atleast_1d(bounding_box_diagonal(Ve))
+    return {"mean_vertex_error": float(np.mean(err)), "relative_error": float(np.mean(err / diag)),
+            "n_components": int(used), "n_meshes": int(len(Ve)), "per_mesh": [float(e) for e in err]}

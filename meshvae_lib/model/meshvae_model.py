@@ -121,7 +121,7 @@ class MeshVAEModel:
         result = train_vae(Xn[~mask], None if C is None else C[~mask], config,
                            val_features=Xn[mask] if mask.any() else None,
                            val_conditions=None if C is None or not mask.any() else C[mask],
-                           mesh=ReferenceMesh(kind.reference, kind.faces, self.features))
+                           mesh=ReferenceMesh(kind.reference, kind.faces, self.features, kind.feature_vertices()))
         D = result.model.latent_dim
         so = pad_sigma_object(config.sigma_object, D)
         self.kind_, self.normalizer_, self.conditions_, self.network_ = kind, normalizer, conditions, result.model

@@ -40,6 +40,7 @@ __all__ = ["Network", "ReferenceMesh", "ARCHITECTURES", "ARCHITECTURE_NAMES", "n
 ARCHITECTURES = {
     "mesh-vae": "meshvae_lib.model.vae:MeshVAE",
     "spiral": "meshvae_lib.model.spiral_net:SpiralVAE",
+    "local-parts": "meshvae_lib.model.local_parts:LocalPartsVAE",
 }
 #: the registered architectures' names (the ``choices`` of ``meshvae train --architecture``).
 ARCHITECTURE_NAMES = tuple(ARCHITECTURES)
@@ -52,11 +53,14 @@ _TRAIN_DEFAULTS = {"epochs": DEFAULT_EPOCHS, "output": "tanh", "loss": "mse"}
 @dataclass(frozen=True)
 class ReferenceMesh:
     """What a network's ``start`` may read of the mesh besides the rows: ``vertices (n, 3)`` float64
-    (the reference mesh), ``faces (n_faces, 3)`` int64 and ``kind``, the feature kind's name."""
+    (the reference mesh), ``faces (n_faces, 3)`` int64, ``kind``, the feature kind's name, and
+    ``feature_vertex (K,)`` int64, the vertex each feature component belongs to (the kind's
+    ``feature_vertices()``; None where unknown)."""
 
     vertices: "np.ndarray"
     faces: "np.ndarray"
     kind: str
+    feature_vertex: "np.ndarray | None" = None
 
 
 @runtime_checkable

@@ -15,7 +15,7 @@ import numpy as np
 
 from meshvae_lib.tolerances import PCA_INIT_RTOL
 
-__all__ = ["PCAStart", "pca_start"]
+__all__ = ["PCAStart", "pca_start", "regional_pca_start", "write_start"]
 
 
 @dataclass
@@ -71,3 +71,64 @@ def pca_start(X: np.ndarray, latent_dim: int, alpha: float) -> PCAStart:
     sol, *_ = np.linalg.lstsq(np.c_[Z, np.ones(n)], A, rcond=None)  # (r + 1, K)
     sigma = 1.0 / np.sqrt(1.0 + alpha * c ** 2 / k)
     return PCAStart(mean=mean, basis=V / c[:, None], sigma=sigma, decoder_weight=sol[:r].T, decoder_bias=sol[r])
+
+
+def regional_pca_start(X: np.ndarray, feature_region: np.ndarray, n_regions: int, per_region: int,
+                       alpha: float) -> tuple[PCAStart, np.ndarray]:
+    """The PCA start of a decoder of local parts: :func:`pca_start` of each region's own columns.
+
+    X : (N >= 2, K) float64 normalised rows; feature_region : (K,) int, the region of each column
+    (``0..n_regions-1``); per_region : the latent dimensions of each region.
+
+    Region g owns latent dimensions ``g * per_region ..`` (its first ``r_g = min(per_region, rank,
+    N - 1)`` are used): its basis rows and decoder columns are zero outside its own features, so
+    each region's features are decoded from its own dimensions only. The deviations use the full
+    row's K (the noise variance K / alpha of Eq. 4 is per component of the whole row).
+
+    Returns (the start, with ``n_regions * per_region`` directions, those beyond a region's rank
+    all zero with deviation 1; ``latent_region (n_regions * per_region,)`` int64, the region of each
+    latent dimension).
+    """
+    n, k = X.shape
+    feature_region = np.asarray(feature_region, dtype=np.int64)
+    if feature_region.shape != (k,) or feature_region.min() < 0 or feature_region.max() >= n_regions:
+        raise ValueError(f"feature_region must be ({k},) in 0..{n_regions - 1}, got shape {feature_region.shape}"
+                         f" and values {feature_region.min()}..{feature_region.max()}")
+    D = n_regions * per_region
+    start = PCAStart(mean=X.mean(axis=0), basis=np.zeros((D, k)), sigma=np.ones(D),
+                     decoder_weight=np.zeros((k, D)), decoder_bias=np.zeros(k))
+    for g in range(n_regions):
+        cols = np.flatnonzero(feature_region == g)
+        if cols.size == 0:
+            continue
+        part = pca_start(X[:, cols], per_region, alpha)
+        dims = g * per_region + np.arange(part.rank)
+        start.basis[np.ix_(dims, cols)] = part.basis
+        c = 1.0 / np.linalg.norm(part.basis, axis=1)  # basis row = v / c with |v| = 1
+        start.sigma[dims] = 1.0 / np.sqrt(1.0 + alpha * c ** 2 / k)
+        start.decoder_weight[np.ix_(cols, dims)] = part.decoder_weight
+        start.decoder_bias[cols] = part.decoder_bias
+    return start, np.repeat(np.arange(n_regions, dtype=np.int64), per_region)
+
+
+def write_start(net, start: PCAStart) -> None:
+    """Set a network without internal layers (a :class:`~meshvae_lib.model.vae.MeshVAE` with
+    ``input_rank = start.rank``) to ``start``: the input projection, an encoder whose means are the
+    projected coefficients and whose deviations are ``start.sigma`` (1 in the latent dimensions
+    beyond the start's rank), the decoder's weight and bias; condition inputs get zero weights."""
+    import torch
+
+    r, D = start.rank, net.latent_dim
+    sigma_logit = np.log(start.sigma / (net.sigma_max - start.sigma))
+    f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
+    with torch.no_grad():
+        net.input_mean.copy_(f32(start.mean))
+        net.input_basis.copy_(f32(start.basis))
+        net.encoder_head.weight.zero_()
+        net.encoder_head.bias.zero_()
+        net.encoder_head.weight[:r, :r] = torch.eye(r)
+        net.encoder_head.bias[D:] = float(np.log(1.0 / (net.sigma_max - 1.0)))  # sigma = 1
+        net.encoder_head.bias[D:D + r] = f32(sigma_logit)
+        net.decoder_head.weight.zero_()
+        net.decoder_head.weight[:, :r] = f32(start.decoder_weight)
+        net.decoder_head.bias.copy_(f32(start.decoder_bias))

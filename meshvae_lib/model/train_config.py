@@ -151,7 +151,8 @@ class TrainConfig:
         """D for a new network trained on ``n_rows`` rows (see ``latent_dim``)."""
         if self.latent_dim is not None:
             return int(self.latent_dim)
-        if self.uses_pca_init(n_conditions):
+        own = getattr(network_class(self.architecture), "train_defaults", {}).get("latent_dim")
+        if own is None and self.uses_pca_init(n_conditions):
             return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
         return int(train_defaults(self.architecture).get("latent_dim", DEFAULT_LATENT))
 

@@ -23,7 +23,7 @@ import torch
 
 from meshvae_lib.defaults import BCE_TARGET_RANGE
 from meshvae_lib.model.inplace_grad import start_step
-from meshvae_lib.model.networks import Network, start_network
+from meshvae_lib.model.networks import Network, network_class, start_network
 from meshvae_lib.model.train_config import TrainConfig, pad_sigma_object
 from meshvae_lib.model.vae import vae_loss
 from meshvae_lib.progress import progress as progress_bar
@@ -303,9 +303,21 @@ def start_is_optimum(config: TrainConfig, n_rows: int, n_conditions: int) -> boo
     """True when a new network's start cannot be improved by training, so early stopping's search is
     skipped: the PCA start (no internal layer, the standard prior, no labels, a tanh output), early
     stopping left to its default (``config.early_stopping is None``; True asks for the search) and a
-    latent size (resolved) of at least ``n_rows - 1``, the rank of the centred rows."""
-    return (config.early_stopping is None and config.uses_pca_init(n_conditions)
-            and config.resolved_latent_dim(n_rows, n_conditions) >= n_rows - 1)
+    latent size (resolved) of at least ``n_rows - 1``, the rank of the centred rows, or a network
+    class whose ``linear_optimum`` says why its start is its optimum."""
+    return _skip_reason(config, n_rows, n_conditions) is not None
+
+
+def _skip_reason(config: TrainConfig, n_rows: int, n_conditions: int) -> str | None:
+    """Why a new network's start is kept untrained (see :func:`start_is_optimum`), or None: the
+    span rule's :data:`START_IS_OPTIMUM`, or the class's own ``linear_optimum`` (the local-parts
+    network's, whose every region starts at its own optimum whatever the latent size)."""
+    if config.early_stopping is not None or not config.uses_pca_init(n_conditions):
+        return None
+    own = getattr(network_class(config.architecture), "linear_optimum", None)
+    if own is None and config.resolved_latent_dim(n_rows, n_conditions) >= n_rows - 1:
+        return START_IS_OPTIMUM
+    return own
 
 
 def train_vae(
@@ -359,9 +371,10 @@ def train_vae(
 
     t0 = time.perf_counter()
     epochs, selection = config.epochs, None
-    if early and start_is_optimum(config, n, n_cond):
-        epochs, selection = 0, {"epochs": 0, "skipped": START_IS_OPTIMUM}
-        logger.info("no epoch search: %s", START_IS_OPTIMUM)
+    skipped = _skip_reason(config, n, n_cond) if early else None
+    if skipped:
+        epochs, selection = 0, {"epochs": 0, "skipped": skipped}
+        logger.info("no epoch search: %s", skipped)
     elif early:
         epochs, selection = _select(x, c, n_cond, loss, device, mesh)
     if model is None:

@@ -43,7 +43,7 @@ from torch import nn
 
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_EPOCHS, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, PRIOR_FORMS, SIGMA_MAX
 from meshvae_lib.model.inplace_grad import Linear
-from meshvae_lib.model.pca_start import pca_start
+from meshvae_lib.model.pca_start import pca_start, write_start
 from meshvae_lib.tolerances import GN_UNUSED_DIM_RTOL, SIGMA_LOGIT_MIN
 
 __all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
@@ -199,21 +199,8 @@ class MeshVAE(nn.Module):
             raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
         D = _latent(config, x.shape[0], n_conditions)
         start = pca_start(x.detach().double().cpu().numpy(), D, config.alpha)
-        r = start.rank
-        net = cls(x.shape[1], D, (), n_conditions, input_rank=r, sigma_floor=config.sigma_floor)
-        sigma_logit = np.log(start.sigma / (net.sigma_max - start.sigma))
-        f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
-        with torch.no_grad():
-            net.input_mean.copy_(f32(start.mean))
-            net.input_basis.copy_(f32(start.basis))
-            net.encoder_head.weight.zero_()
-            net.encoder_head.bias.zero_()
-            net.encoder_head.weight[:r, :r] = torch.eye(r)
-            net.encoder_head.bias[D:] = float(np.log(1.0 / (net.sigma_max - 1.0)))  # sigma = 1
-            net.encoder_head.bias[D:D + r] = f32(sigma_logit)
-            net.decoder_head.weight.zero_()
-            net.decoder_head.weight[:, :r] = f32(start.decoder_weight)
-            net.decoder_head.bias.copy_(f32(start.decoder_bias))
+        net = cls(x.shape[1], D, (), n_conditions, input_rank=start.rank, sigma_floor=config.sigma_floor)
+        write_start(net, start)
         return net
 
     def describe(self) -> str:

@@ -78,6 +78,11 @@ class FeatureKind:
     def n_features(self) -> int:
         raise NotImplementedError
 
+    def feature_vertices(self) -> np.ndarray:
+        """The vertex each feature component belongs to: ``(K,)`` int64 in ``0..n_vertices-1`` (for a
+        decoder of local parts, :class:`~meshvae_lib.model.local_parts.LocalPartsVAE`)."""
+        raise NotImplementedError(f"the {self.name!r} feature kind does not say where its components lie")
+
     def get_options(self) -> dict:
         """The kind's options, ``{keyword: value}`` (what :meth:`__init__` takes beyond the mesh)."""
         return {k: getattr(self, k) for k in self.options}

@@ -23,6 +23,10 @@ class CoordinatesKind(FeatureKind):
     def n_features(self) -> int:
         return 3 * self.n_vertices
 
+    def feature_vertices(self) -> np.ndarray:
+        """Component ``3 i + c`` is vertex i's coordinate c: ``(3 n,)`` int64."""
+        return np.repeat(np.arange(self.n_vertices, dtype=np.int64), 3)
+
     def _encode(self, V: np.ndarray) -> np.ndarray:
         return V.reshape(len(V), -1).copy()
 

@@ -76,6 +76,14 @@ class RIMDKind(FeatureKind):
                                                     operator=self.operator)
         return self._reconstructor
 
+    def feature_vertices(self) -> np.ndarray:
+        """``(K,)`` int64: a rotation block ``log dR_ij`` (3 numbers) belongs to vertex i, the
+        edge's first vertex (in the paper's layout every edge out of i is i's), an S block (6
+        numbers) to its vertex."""
+        lay = self._encoder.layout if self._encoder is not None else RIMDLayout(self._faces, self.n_vertices, self.layout)
+        return np.concatenate([np.repeat(lay.rotation_edges[:, 0], 3),
+                               np.repeat(np.arange(self.n_vertices, dtype=np.int64), 6)]).astype(np.int64)
+
     def _encode(self, V: np.ndarray) -> np.ndarray:
         return np.asarray(self.encoder.transform(V), dtype=np.float64).reshape(len(V), -1)
 

@@ -1,4 +1,4 @@
-"""Wrong answers to the exercises of notebook 10_bring_your_own: each must make its self-check raise.
+"""Wrong answers to the exercises of notebook 11_bring_your_own: each must make its self-check raise.
 
 Keys are exercise numbers from 1; values map a short description to the code run in place of
 the solution (tests/test_exercise_checks.py runs them)."""
