@@ -93,7 +93,8 @@ class LocalPartsVAE(MeshVAE):
         from meshvae_lib.geometry.regions import mesh_regions
 
         if mesh is None or mesh.feature_vertex is None:
-            raise ValueError("the local-parts network needs the reference mesh and where each feature lies")
+            raise ValueError("the local-parts network needs the reference mesh and where each feature lies"
+                             f" (the feature kind's feature_vertices()); {None if mesh is None else mesh.kind!r} does not say")
         if config.hidden or config.output != "tanh" or n_conditions:
             raise ValueError(f"the local-parts network has no internal layers, a tanh output and no labels;"
                              f" got hidden={config.hidden}, output={config.output!r}, {n_conditions} conditions")

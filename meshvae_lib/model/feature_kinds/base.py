@@ -78,10 +78,11 @@ class FeatureKind:
     def n_features(self) -> int:
         raise NotImplementedError
 
-    def feature_vertices(self) -> np.ndarray:
+    def feature_vertices(self) -> np.ndarray | None:
         """The vertex each feature component belongs to: ``(K,)`` int64 in ``0..n_vertices-1`` (for a
-        decoder of local parts, :class:`~meshvae_lib.model.local_parts.LocalPartsVAE`)."""
-        raise NotImplementedError(f"the {self.name!r} feature kind does not say where its components lie")
+        decoder of local parts, :class:`~meshvae_lib.model.local_parts.LocalPartsVAE`), or None for a
+        kind that does not say (the base class's answer; such a kind cannot train a decoder of parts)."""
+        return None
 
     def get_options(self) -> dict:
         """The kind's options, ``{keyword: value}`` (what :meth:`__init__` takes beyond the mesh)."""
