@@ -520,7 +520,8 @@ def test_former_hangs_end_within_seconds_with_exit_2(w, name, tmp_path):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
-def test_a_real_ctrl_c_during_training_exits_130_without_a_traceback(w, tmp_path):
+@pytest.mark.parametrize("delay", [0.3, 1.0, 1.7])  # CPython's own exit said -2 for about 1 in 5 (issue 40's CI)
+def test_a_real_ctrl_c_during_training_exits_130_without_a_traceback(w, tmp_path, delay):
     import signal
 
     old = tmp_path / "old.pt"
@@ -531,7 +532,7 @@ def test_a_real_ctrl_c_during_training_exits_130_without_a_traceback(w, tmp_path
     try:
         line = proc.stderr.readline()  # "training on ..." once the data is read and training starts
         assert line.startswith("training on"), line
-        time.sleep(1.0)
+        time.sleep(delay)
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=60)
     finally:

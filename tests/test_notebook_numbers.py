@@ -32,6 +32,7 @@ NUMBER = re.compile(r"(?<![\w.])(\d{1,3}(?:,\d{3})+(?:\.\d+)?|\d+(?:\.\d+)?(?:[e
 REFERENCE_BEFORE = re.compile(r"(Sec\.|Secs\.|Section|sections?|notebooks?|Figs?\.|Tables?|Eqs?\.|Equations?|cells?"
                               r"|exercises?|steps?|dims?|dimensions?|seeds?|\()\s*$", re.IGNORECASE)
 SECTION_LIST = re.compile(r"\b(Secs?\.|Sections?)\s*[\d.]+(?:\s*(?:,|and|–|-|to)\s*[\d.]+)*", re.IGNORECASE)
+TITLE_NUMBER = re.compile(r"^(#{1,6}\s*)\d+\s*·", re.MULTILINE)  # a notebook's own number: "# 11 · Bring ..."
 YEAR = re.compile(r"^(19|20)\d\d$")
 HEADING = re.compile(r"^#{1,6}\s", re.MULTILINE)
 WORD = re.compile(r"\w+")
@@ -109,6 +110,7 @@ def _shown_values(text: str) -> set[Decimal]:
 
 
 def _clean_markdown(md: str) -> str:
+    md = TITLE_NUMBER.sub(r"\1", md)
     md = re.sub(r"\$\$.*?\$\$", " ", md, flags=re.DOTALL)
     md = re.sub(r"\$[^$]*\$", " ", md)
     md = re.sub(r"`([^`]*)`", lambda c: c.group(1) if "docs/" in c.group(1) else " CODE ", md)
@@ -182,6 +184,12 @@ def test_the_scanner_finds_an_unsupported_number_and_accepts_supported_ones():
     assert unsupported_numbers(nb) == []
     nb["cells"][0]["source"] = ["## A\nA stretch of 32.5 is far from 1."]
     assert len(unsupported_numbers(nb)) == 1 and "32.5" in unsupported_numbers(nb)[0]
+
+
+def test_a_notebooks_own_number_in_its_title_is_not_a_quantity_but_the_same_number_later_is():
+    nb = _nb(("markdown", "# 11 · Bring your own meshes\nIt takes 11 minutes.", None), ("code", "x", "nothing"))
+    bad = unsupported_numbers(nb)
+    assert len(bad) == 1 and "11 minutes" in bad[0]
 
 
 def test_a_number_printed_in_another_section_does_not_count():
