@@ -275,7 +275,7 @@ def test_inference_options_are_checked(arcs, arc_model):
 
 def test_a_code_where_the_decoder_saturates_ends_the_fit_instead_of_failing(arcs, arc_model, tmp_path):
     """Far outside the training meshes every tanh output can saturate: the decoded mesh then no
-    longer moves with the code (J = 0; found on notebook 10's bar with 8 training meshes). The fit
+    longer moves with the code (J = 0; found on notebook 11's bar with 8 training meshes). The fit
     stops at the best code found so far instead of failing on a singular system."""
     from meshvae_lib.model.meshvae_model import load_model
 
