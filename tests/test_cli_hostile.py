@@ -528,7 +528,10 @@ def test_a_real_ctrl_c_during_training_exits_130_without_a_traceback(w, tmp_path
     old.write_bytes(b"old model")
     proc = subprocess.Popen([sys.executable, "-m", "meshvae_lib.cli", "train", str(w.data), "-o", str(old),
                              "--epochs", "1000000", "--init", "random", "--no-early-stopping", "--latent", "2"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+                            # a user's terminal delivers Ctrl-C; a test run started in the background
+                            # (`make test &`) ignores SIGINT, and its children would inherit that
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         line = proc.stderr.readline()  # "training on ..." once the data is read and training starts
         assert line.startswith("training on"), line
