@@ -9,9 +9,10 @@ out, as ``training.holdout_mask`` does: 140 of samba's 175) to a temporary ``.np
 ``meshvae train that.npz -o model.pt --no-progress`` as a fresh process ``--repeats`` times: the
 command's defaults (RIMD, PCA start, no meshes held out, so no evaluation at the end). Prints each
 wall time, the median, the command's own report, and whether every written model is the same
-(``torch.equal`` on every tensor of the network and the normaliser). With ``--evaluate`` it also
-runs the same command on the whole collection with ``--holdout-every K``: training plus the
-default inference of the held-out meshes, which is the inference's cost (``bench_inference.py``).
+(``torch.equal`` on every tensor of the checkpoint: the network's state, the normaliser, ...).
+With ``--evaluate`` it also runs the same command on the whole collection with
+``--holdout-every K``: training plus the default inference of the held-out meshes, which is the
+inference's cost (``bench_inference.py``).
 
 Measured on 4 December 2026 (2 cores, quiet; docs/results/inference_speed.md): samba, 140 training
 meshes, median 26.4 s (25.1-30.0 s over 3 runs), the same tensors every run; the code before issue 38
@@ -64,8 +65,7 @@ def main() -> None:
     keep = ~holdout_mask(len(coll.vertices), args.holdout_every)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        train = type(coll)(coll.vertices[keep], coll.faces, names=[n for n, k in zip(coll.names, keep) if k])
-        data = write_collection(tmp / "train.npz", train)
+        data = write_collection(tmp / "train.npz", coll.subset(keep))
         print(f"{args.real}: {int(keep.sum())} training meshes of {len(keep)}, {coll.vertices.shape[1]} vertices")
         times, states = [], []
         for r in range(args.repeats):
