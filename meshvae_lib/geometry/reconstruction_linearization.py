@@ -71,21 +71,29 @@ class ReconstructionLinearization:
     def __init__(self, reconstructor, w: np.ndarray, S: np.ndarray, R: np.ndarray, positions: np.ndarray,
                  record: dict):
         layout = reconstructor.layout
-        n = layout.n_vertices
         self._layout = layout
         self._rotations = reconstructor.rotation_recovery
         self._positions_solver = reconstructor.position_solver
         self.positions = positions
         self.positions.setflags(write=False)
         self.n_features = int(layout.K)
-        Rm = np.ascontiguousarray(R.T).reshape(n, 3, 3)
-        Tm = np.ascontiguousarray(matmul_soa(R, S).T).reshape(n, 3, 3)
         self._record = record
-        # edge e: d(edge rotation vector) -> its body-frame turn eta_e = J_r(w_e) dw_e
-        self._edge_map = right_jacobian(np.ascontiguousarray(w.T))
-        # g_i -> dT_i = hat(g_i) T_i, as (9, 3) per vertex; dS6_i -> R_i dS_i, as (9, 6)
-        self._g_map = np.einsum("kac,ncb->nabk", _GENERATORS, Tm).reshape(n, 9, 3)
-        self._s_map = np.einsum("nac,cbk->nabk", Rm, _S6_TO_9.reshape(3, 3, 6)).reshape(n, 9, 6)
+        self._R, self._S, self._w = R, S, w
+        self._maps = None
+
+    def _vertex_maps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The per-edge and per-vertex maps of the products, computed on first use (a decode that
+        is never differentiated, such as a rejected trial step, does not pay for them): ``J_r(w_e)``
+        ``(E, 3, 3)``: d(edge rotation vector) -> its body-frame turn ``eta_e``; ``g_i -> dT_i =
+        hat(g_i) T_i`` ``(n, 9, 3)``; ``dS6_i -> R_i dS_i`` ``(n, 9, 6)``."""
+        if self._maps is None:
+            n = self._layout.n_vertices
+            Rm = np.ascontiguousarray(self._R.T).reshape(n, 3, 3)
+            Tm = np.ascontiguousarray(matmul_soa(self._R, self._S).T).reshape(n, 3, 3)
+            self._maps = (right_jacobian(np.ascontiguousarray(self._w.T)),
+                          np.einsum("kac,ncb->nabk", _GENERATORS, Tm).reshape(n, 9, 3),
+                          np.einsum("nac,cbk->nabk", Rm, _S6_TO_9.reshape(3, 3, 6)).reshape(n, 9, 6))
+        return self._maps
 
     # -- feature space <-> per-edge / per-vertex blocks ----------------------------------------
     def _split(self, dF: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -129,13 +137,14 @@ class ReconstructionLinearization:
         dF = dF[:, None] if single else dF
         if dF.ndim != 2 or dF.shape[0] != self.n_features:
             raise ValueError(f"dF must have shape ({self.n_features},) or ({self.n_features}, d), got {dF.shape}")
+        edge_map, g_map, s_map = self._vertex_maps()
         d = dF.shape[1]
         dP = np.empty((self._layout.n_vertices, 3, d))
         for k in range(0, d, JVP_BLOCK):     # blocks of columns: the intermediates stay small
             dw, dS6 = self._split(dF[:, k:k + JVP_BLOCK])
-            g = self._rotations.linear_response(self._record, self._edge_map @ dw)   # (n, 3, b)
-            dT = self._g_map @ g
-            dT += self._s_map @ dS6                                           # (n, 9, b)
+            g = self._rotations.linear_response(self._record, edge_map @ dw)   # (n, 3, b)
+            dT = g_map @ g
+            dT += s_map @ dS6                                                 # (n, 9, b)
             dP[:, :, k:k + JVP_BLOCK] = self._positions_solver.solve_gradients(dT)
         return dP[:, :, 0] if single else dP
 
@@ -156,10 +165,11 @@ class ReconstructionLinearization:
         n = self._layout.n_vertices
         if dP.ndim != 3 or dP.shape[:2] != (n, 3):
             raise ValueError(f"dP must have shape ({n}, 3) or ({n}, 3, d), got {dP.shape}")
+        edge_map, g_map, s_map = self._vertex_maps()
         dT_adj = self._positions_solver.solve_gradients_adjoint(dP)        # (n, 9, d)
-        g_adj = self._g_map.transpose(0, 2, 1) @ dT_adj                  # (n, 3, d)
-        dS6_adj = self._s_map.transpose(0, 2, 1) @ dT_adj                 # (n, 6, d)
+        g_adj = g_map.transpose(0, 2, 1) @ dT_adj                        # (n, 3, d)
+        dS6_adj = s_map.transpose(0, 2, 1) @ dT_adj                       # (n, 6, d)
         eta_adj = self._rotations.linear_response_adjoint(self._record, g_adj)   # (E, 3, d)
-        dw_adj = self._edge_map.transpose(0, 2, 1) @ eta_adj
+        dw_adj = edge_map.transpose(0, 2, 1) @ eta_adj
         dF = self._join(dw_adj, dS6_adj)
         return dF[:, 0] if single else dF

@@ -231,13 +231,13 @@ class RotationRecovery:
         return R, record
 
     # -- first-order response (geometry.reconstruction_linearization) -------------------------
-    def _edge_terms(self, R: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """At rotations R (9, n): ``R`` as (n, 3, 3) and, per edge, the matrices that map a global
-        rotation of ``R_i`` / of ``R_j dR_ij^-1`` to the change of the residual
-        ``vee(skew(D))``, ``D = R_i dR_ij R_j^T``: ``(tr D I - D) / 2`` and ``(tr D I - D^T) / 2``."""
+    def _edge_terms(self, R: np.ndarray, dR: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """At rotations R (9, n) and edge rotations ``dR (n_edges, 3, 3)``: ``R`` as (n, 3, 3) and, per
+        edge, the matrices that map a global rotation of ``R_i`` / of ``R_j dR_ij^-1`` to the change of
+        the residual ``vee(skew(D))``, ``D = R_i dR_ij R_j^T``: ``(tr D I - D) / 2`` and
+        ``(tr D I - D^T) / 2``."""
         n, E = self.n_vertices, self.edges
         Rm = np.ascontiguousarray(R.T).reshape(n, 3, 3)
-        dR = np.ascontiguousarray(exp_soa(w).T).reshape(-1, 3, 3)
         D = Rm[E[:, 0]] @ dR @ Rm[E[:, 1]].transpose(0, 2, 1)
         tr = np.trace(D, axis1=1, axis2=2)[:, None, None] * np.eye(3)
         return Rm, 0.5 * (tr - D), 0.5 * (tr - D.transpose(0, 2, 1))
@@ -256,8 +256,9 @@ class RotationRecovery:
         u, flip, par = self._parent_edge[child], self._parent_flip[child], self._parent[child]
         walk = np.where(flip[:, None, None], -Rb[par], Rb[child])
         steps = []
+        dR = np.ascontiguousarray(exp_soa(record["w"]).T).reshape(-1, 3, 3) if record["steps"] else None
         for R, omega in record["steps"]:
-            Rm, Ml, Mr = self._edge_terms(R, record["w"])
+            Rm, Ml, Mr = self._edge_terms(R, dR)
             Ex = np.ascontiguousarray(exp_soa(np.ascontiguousarray(omega.T)).T).reshape(n, 3, 3)
             steps.append({"Ml": Ml, "Mr": Mr, "MrR": Mr @ Rm[self.edges[:, 1]], "Rj": Rm[self.edges[:, 1]],
                           "Jl": right_jacobian(-omega), "Ex": Ex})
