@@ -11,12 +11,16 @@ Jacobian) and, with ``--finite-difference``, the old forward-difference fit. Med
     python benchmarks/bench_inference.py --real samba --subsample 3  # trains the default model first
     python benchmarks/bench_inference.py --synth scape            # without the real data
     python benchmarks/bench_inference.py --real samba --jobs 1 2 --solvers   # issue 38's measurements
+    python benchmarks/bench_inference.py --real samba --meshes 8 --step-options   # fewer steps: error and time
 
 ``--jobs 1 2`` also times ``encode_meshes`` of all ``--meshes`` meshes at once with that many worker
 processes (seconds per mesh = total / meshes: the throughput of ``evaluate``). ``--solvers`` times
 the sparse solves of one Jacobian alone: the synchronisation and position systems with three
 right-hand sides per used dimension, by SuperLU (in chunks of 12, and all at once) and by CHOLMOD
-(``cholespy``, the library's choice): the floor of one Jacobian.
+(``cholespy``, the library's choice): the floor of one Jacobian. ``--step-options`` fits the
+``--meshes`` meshes (one process) with fewer Gauss-Newton steps and with chord steps
+(``meshvae evaluate --gn-steps N --chord-steps M``) and prints, against the default (4 steps), the
+mean error's ratio, the worst single mesh's ratio and the seconds per mesh.
 """
 
 from __future__ import annotations
@@ -47,6 +51,8 @@ def main() -> None:
     ap.add_argument("--finite-difference", action="store_true", help="also time the forward-difference fit (slow)")
     ap.add_argument("--jobs", type=int, nargs="*", default=[], help="also time all meshes at once with these worker counts")
     ap.add_argument("--solvers", action="store_true", help="also time one Jacobian's sparse solves alone")
+    ap.add_argument("--step-options", action="store_true",
+                    help="also fit the meshes with fewer Gauss-Newton steps and with chord steps (error and time)")
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
     if args.model:
@@ -88,6 +94,31 @@ def main() -> None:
               f" max {max(times):.3f}), mean error {model.last_inference_.final_error.mean():.6g}", flush=True)
     if args.solvers:
         solver_floor(model, args.repeats)
+    if args.step_options:
+        step_options(model, V)
+
+
+#: (Jacobians at most, chord steps after each accepted step) measured by ``--step-options``; the first
+#: is the default.
+STEP_OPTIONS = ((4, 0), (3, 0), (2, 0), (1, 0), (3, 1), (2, 1), (2, 2), (1, 2))
+
+
+def step_options(model, V: np.ndarray) -> None:
+    """Held-out error and time with fewer Gauss-Newton steps or chord steps, against the default."""
+    from meshvae_lib.model.inference.gauss_newton import gauss_newton_codes
+
+    mu, _ = model.encode_rows(model.features_of(V), None)
+    base = None
+    print(f"fewer steps, {len(V)} meshes, one process (error ratios against 4 steps):")
+    for iterations, chord in STEP_OPTIONS:
+        t0 = time.perf_counter()
+        _, report = gauss_newton_codes(model, V, mu, n_jobs=1, iterations=iterations, chord_steps=chord)
+        seconds = (time.perf_counter() - t0) / len(V)
+        err = report.final_error
+        base = err if base is None else base
+        print(f"  --gn-steps {iterations} --chord-steps {chord}: mean error {err.mean():.6g}"
+              f" ({err.mean() / base.mean():.4f}x, worst mesh {np.max(err / base):.3f}x), {seconds:.2f} s per mesh,"
+              f" {report.iterations.mean():.2f} Jacobians and {report.decodes.mean():.2f} decodes per mesh", flush=True)
 
 
 def solver_floor(model, repeats: int) -> None:

@@ -183,6 +183,21 @@ def test_evaluate_with_codes_fitted_to_the_vertices(data, capsys):
     assert all(d <= p * (1 + 1e-6) + 1e-12 for d, p in zip(default["per_mesh"], plain["per_mesh"]))
     assert main(["evaluate", str(model), str(path), "--fit-latent", "2", "--inference", "encoder"]) == 2
     assert "does not combine" in capsys.readouterr().err
+    # fewer Gauss-Newton steps: the same first steps, so never better per mesh; the default's count
+    # gives the default's errors exactly; a chord step after each accepted one never loses
+    runs = {}
+    for extra in ([], ["--gn-steps", "4"], ["--gn-steps", "1"], ["--gn-steps", "1", "--chord-steps", "2"]):
+        assert main(["evaluate", str(model), str(path), "--held-out", "--json", "--jobs", "1"] + extra) == 0
+        runs[" ".join(extra)] = json.loads(capsys.readouterr().out)
+    assert runs["--gn-steps 4"]["per_mesh"] == runs[""]["per_mesh"]
+    assert runs["--gn-steps 1"]["inference_description"] == "encoder + Gauss-Newton, 1 step"
+    assert runs["--gn-steps 1 --chord-steps 2"]["inference_description"] == "encoder + Gauss-Newton, 1 step (+2 chord each)"
+    one, chord = runs["--gn-steps 1"]["per_mesh"], runs["--gn-steps 1 --chord-steps 2"]["per_mesh"]
+    assert all(d <= o * (1 + 1e-9) for d, o in zip(runs[""]["per_mesh"], one))
+    assert all(c <= o * (1 + 1e-9) for c, o in zip(chord, one))
+    assert sum(one) > sum(runs[""]["per_mesh"]) * (1 + 1e-6)    # the later steps do lower the error here
+    assert main(["evaluate", str(model), str(path), "--held-out", "--gn-steps", "1", "--chord-steps", "1"]) == 0
+    assert "(encoder + Gauss-Newton, 1 step (+1 chord each))" in capsys.readouterr().out
     assert main(["evaluate", str(model), str(path), "--fit-latent", "-1"]) == 2
     assert "--fit-latent must be >= 0" in capsys.readouterr().err
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference import INFERENCE_METHODS
 
 from . import UsageError, add_allow_degenerate, add_command, add_model_argument, check_at_least, check_at_most, result
@@ -25,6 +26,7 @@ examples:
   meshvae evaluate scape.pt held_out.npz --pca train.npz        # PCA fitted on another file
   meshvae evaluate scape.pt scape.npz --held-out --inference encoder  # the paper's encoder
   meshvae evaluate scape.pt scape.npz --held-out --fit-latent 3  # codes fitted by finite differences
+  meshvae evaluate scape.pt scape.npz --gn-steps 2 --chord-steps 1  # fewer Jacobians: faster, less accurate
 
 --pca adds the linear floor: PCA on vertex coordinates fitted on the training meshes (by default
 the meshes of DATA the model did not hold out; or those of the given file), with all the
@@ -55,6 +57,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="processes fitting meshes at once with the default inference (default: every available"
                         " core; the codes do not depend on it)")
+    p.add_argument("--gn-steps", type=int, default=None, metavar="N",
+                   help=f"Jacobians per mesh at most with the default inference (default {GAUSS_NEWTON_ITERATIONS});"
+                        " fewer is faster and less accurate (docs/results/inference_speed.md)")
+    p.add_argument("--chord-steps", type=int, default=None, metavar="N",
+                   help="with the default inference, up to N more steps after each accepted one with the same"
+                        " Jacobian (a decode each instead of a Jacobian; default 0)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar while codes are fitted")
     add_allow_degenerate(p)
     return p
@@ -72,14 +80,26 @@ def run(args) -> int:
     if args.pca_components is not None:
         check_at_least(args.pca_components, 1, "--pca-components")
     inference = args.inference
-    if args.jobs is not None:
-        check_at_least(args.jobs, 1, "--jobs")
+    gn_options = {name: value for name, value in
+                  (("n_jobs", args.jobs), ("iterations", args.gn_steps), ("chord_steps", args.chord_steps))
+                  if value is not None}
+    if gn_options:
+        flags = {"n_jobs": "--jobs", "iterations": "--gn-steps", "chord_steps": "--chord-steps"}
+        given = ", ".join(flags[name] for name in gn_options)
         if args.fit_latent or inference not in (None, "gauss-newton"):
-            raise UsageError("--jobs sets the processes of the default inference (gauss-newton); it does not combine"
+            raise UsageError(f"{given}: options of the default inference (gauss-newton), which does not combine"
                              f" with {'--fit-latent' if args.fit_latent else '--inference ' + str(inference)}")
+        if args.jobs is not None:
+            check_at_least(args.jobs, 1, "--jobs")
+        if args.gn_steps is not None:
+            check_at_least(args.gn_steps, 1, "--gn-steps")
+            check_at_most(args.gn_steps, MAX_SOLVER_STEPS, "--gn-steps", "Gauss-Newton steps per mesh")
+        if args.chord_steps is not None:
+            check_at_least(args.chord_steps, 0, "--chord-steps")
+            check_at_most(args.chord_steps, MAX_SOLVER_STEPS, "--chord-steps", "chord steps per Jacobian")
         from meshvae_lib.model.inference.gauss_newton import GaussNewton
 
-        inference = GaussNewton(n_jobs=args.jobs)
+        inference = GaussNewton(**gn_options)
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model, collection)
     if args.fit_latent and args.inference not in (None, "finite-difference"):
@@ -111,6 +131,7 @@ def run(args) -> int:
                f" ({100 * res['relative_error']:.3g}% of the bounding-box diagonal; features {res['features']}"
                + f"; inference {res['inference']}"
                + (f", {args.fit_latent} steps" if args.fit_latent else "")
+               + (f" ({res['inference_description']})" if {"iterations", "chord_steps"} & set(gn_options) else "")
                + f"; {res['seconds_per_mesh']:.2g} s per mesh)")
         result(f"worst: {res['names'][worst]} ({res['per_mesh'][worst]:.6g})")
         if "pca" in res:

@@ -87,6 +87,7 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
         "features": model.feature_kind.name,
         "fit_iterations": int(strategy.iterations) if strategy.name == "finite-difference" else 0,
         "inference": strategy.name,
+        "inference_description": strategy.describe(),
         "seconds_per_mesh": seconds / idx.size,
     }
 

@@ -226,7 +226,7 @@ class GaussNewton(InferenceStrategy):
 
     def describe(self) -> str:
         chord = f" (+{self.chord_steps} chord each)" if self.chord_steps else ""
-        return f"encoder + Gauss-Newton, {self.iterations} steps{chord}"
+        return f"encoder + Gauss-Newton, {self.iterations} step{'s' if self.iterations != 1 else ''}{chord}"
 
     def infer(self, model, vertices: np.ndarray, conditions: np.ndarray | None, progress: bool = False) -> np.ndarray:
         mu, _ = model.encode_rows(model.features_of(vertices), conditions)
