@@ -80,23 +80,21 @@ def run(args) -> int:
     if args.pca_components is not None:
         check_at_least(args.pca_components, 1, "--pca-components")
     inference = args.inference
-    gn_options = {name: value for name, value in
-                  (("n_jobs", args.jobs), ("iterations", args.gn_steps), ("chord_steps", args.chord_steps))
-                  if value is not None}
-    if gn_options:
-        flags = {"n_jobs": "--jobs", "iterations": "--gn-steps", "chord_steps": "--chord-steps"}
-        given = ", ".join(flags[name] for name in gn_options)
+    # the default inference's options: (flag, GaussNewton keyword, value, least value, budget of the most)
+    given = [option for option in (("--jobs", "n_jobs", args.jobs, 1, None),
+                                   ("--gn-steps", "iterations", args.gn_steps, 1, "Gauss-Newton steps per mesh"),
+                                   ("--chord-steps", "chord_steps", args.chord_steps, 0, "chord steps per Jacobian"))
+             if option[2] is not None]
+    gn_options = {name: value for _, name, value, _, _ in given}
+    if given:
         if args.fit_latent or inference not in (None, "gauss-newton"):
-            raise UsageError(f"{given}: options of the default inference (gauss-newton), which does not combine"
+            raise UsageError(f"{', '.join(flag for flag, *_ in given)}: options of the default inference (gauss-newton),"
+                             " which does not combine"
                              f" with {'--fit-latent' if args.fit_latent else '--inference ' + str(inference)}")
-        if args.jobs is not None:
-            check_at_least(args.jobs, 1, "--jobs")
-        if args.gn_steps is not None:
-            check_at_least(args.gn_steps, 1, "--gn-steps")
-            check_at_most(args.gn_steps, MAX_SOLVER_STEPS, "--gn-steps", "Gauss-Newton steps per mesh")
-        if args.chord_steps is not None:
-            check_at_least(args.chord_steps, 0, "--chord-steps")
-            check_at_most(args.chord_steps, MAX_SOLVER_STEPS, "--chord-steps", "chord steps per Jacobian")
+        for flag, _, value, least, budget in given:
+            check_at_least(value, least, flag)
+            if budget:
+                check_at_most(value, MAX_SOLVER_STEPS, flag, budget)
         from meshvae_lib.model.inference.gauss_newton import GaussNewton
 
         inference = GaussNewton(**gn_options)
