@@ -10,7 +10,7 @@ from data_synth.humanoid import NAMES, BodyShape, body_template, pose_body, shap
 from data_synth.motions import MOTIONS, Pose, limb_clearance, motion_sequence, random_poses
 from data_synth.skeleton import forward_kinematics
 
-__all__ = ["make_scape", "make_dyna", "make_jumping", "DYNA_SHAPES", "pose_shape", "checked_sequence"]
+__all__ = ["make_scape", "make_dyna", "make_jumping", "make_poses", "poses_dof", "DYNA_SHAPES", "pose_shape", "checked_sequence"]
 
 #: the Dyna-like collection's body shapes (jittered a little per seed).
 DYNA_SHAPES = {
@@ -146,4 +146,53 @@ def make_jumping(seed: int = 0, resolution: int | None = None,
         labels={"frame": np.arange(n_frames, dtype=np.int64)},
         description="Jumping-like: one body doing jumping jacks, 10 frames a jack",
         extras={"rest": shape_body(template, shape)[0], "shape_params": shape.as_dict()},
+    )
+
+
+def poses_dof(n: int, rng: np.random.Generator) -> tuple[Pose, np.ndarray]:
+    """``n`` poses of the sixteen named joint angles of :data:`constants.POSES_DOF`, each drawn
+    uniformly and independently in its range, redrawn until every pose passes the skeleton check
+    (:func:`~data_synth.motions.limb_clearance`). Returns the poses (feet planted) and their angles
+    ``(n, 16) float64`` in the order of ``POSES_DOF``."""
+    if n < 1:
+        raise ValueError(f"n must be at least 1, got {n}")
+    names = list(C.POSES_DOF)
+    low, high = np.array([C.POSES_DOF[k] for k in names]).T
+    local, angles = [], []
+    while sum(len(a) for a in angles) < n:
+        a = rng.uniform(low, high, size=(n, len(names)))
+        d = dict(zip(names, a.T))
+        pose = Pose.identity(n)
+        pose.plant = ("l_foot", "r_foot")
+        for s in "lr":
+            pose.arm(s, lower=d[f"{s}_arm_lower"], forward=d[f"{s}_arm_forward"], twist=d[f"{s}_arm_twist"],
+                     elbow=d[f"{s}_elbow"])
+            pose.leg(s, hip=d[f"{s}_hip"], knee=d[f"{s}_knee"])
+        pose.trunk(bend=d["trunk_bend"], twist=d["trunk_twist"], head_nod=d["head_nod"], head_turn=d["head_turn"])
+        keep = np.flatnonzero(limb_clearance(pose) >= 0.0)
+        local.append(pose.local[keep])
+        angles.append(a[keep])
+    local = np.concatenate(local)[:n]
+    return Pose(local, np.zeros((n, 3)), plant=("l_foot", "r_foot")), np.concatenate(angles)[:n]
+
+
+def make_poses(seed: int = 0, resolution: int | None = None, n_poses: int = C.POSES_N) -> SynthCollection:
+    """One body in ``n_poses`` (default 1,200) random poses of sixteen named joint angles (four per
+    arm, two per leg, four of trunk and head; :data:`constants.POSES_DOF`), each drawn
+    independently, so that the collection's degrees of freedom are known: the collection on which
+    the course measures where a nonlinear decoder starts to pay (issue 47). The rest pose is not
+    among them. ``extras['dof']`` is ``(n_poses, 16) float64``, the angles of each mesh, and
+    ``extras['dof_names']`` their names."""
+    if isinstance(n_poses, bool) or not isinstance(n_poses, (int, np.integer)) or n_poses < 2:
+        raise ValueError(f"n_poses must be an integer >= 2, got {n_poses!r}")
+    rng = np.random.default_rng(seed)
+    template = body_template(resolution)
+    shape = _jitter(BodyShape(), rng)
+    pose, angles = poses_dof(int(n_poses), rng)
+    V = pose_shape(template, shape, pose)
+    return SynthCollection(
+        vertices=V, faces=template.F.copy(), names=[f"pose_{i:04d}" for i in range(len(V))], labels={},
+        description=f"one body in {len(V)} poses of 16 joint angles drawn independently",
+        extras={"rest": shape_body(template, shape)[0], "shape_params": shape.as_dict(), "dof": angles,
+                "dof_names": list(C.POSES_DOF)},
     )

@@ -33,6 +33,9 @@ COLLECTIONS: dict[str, CollectionSpec] = {
     for spec in (
         CollectionSpec("scape", bodies.make_scape,
                        "one body in 71 distinct poses, every joint drawn (2.5k vertices)", "SCAPE (Anguelov et al.)"),
+        CollectionSpec("poses", bodies.make_poses,
+                       "one body in 1,200 poses of 16 joint angles drawn independently (known degrees of freedom)",
+                       "a large collection: where a nonlinear decoder starts to pay"),
         CollectionSpec("dyna", bodies.make_dyna,
                        "5 body shapes x 7 motions x 6 frames, labels shape/motion/frame",
                        "Dyna (Pons-Moll et al.)"),

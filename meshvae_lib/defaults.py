@@ -173,3 +173,24 @@ MESSAGE_NAME_CHARS = 60
 #: ...and a mesh name to this many characters when it becomes part of a file name (file systems
 #: allow 255 bytes).
 FILE_NAME_CHARS = 100
+
+# --- the corrected decoder (``model.corrected_decoder``, issue 47) -----------------------------
+#: the correction network's internal layers, its AdamW weight decay, the weight of the Gaussian
+#: penalty on the free codes, Adam's step, the most full-batch steps, how often (steps) the
+#: validation rows are measured and how many checks without a new best end training, which training
+#: rows are set aside (every k-th), the least relative gain on them for which the correction is kept,
+#: the most principal directions it writes into, and the L-BFGS iterations of a code fit.
+CORRECTION_HIDDEN = (128, 128)
+CORRECTION_WEIGHT_DECAY = 1e-4
+CORRECTION_CODE_PRIOR = 1e-3
+CORRECTION_LR = 3e-3
+CORRECTION_MAX_STEPS = 4000
+CORRECTION_CHECK_EVERY = 50
+CORRECTION_PATIENCE = 8
+CORRECTION_VALIDATION_EVERY = 5
+CORRECTION_MIN_GAIN = 0.02
+#: ... and how many standard errors of the mean gain per validation mesh it must clear (the
+#: validation meshes are few: at 50 training meshes, 5 choose).
+CORRECTION_CONFIDENCE = 2.0
+CORRECTION_RANK = 128
+CORRECTION_FIT_ITERATIONS = 60

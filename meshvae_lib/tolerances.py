@@ -178,3 +178,10 @@ FD_LINEARIZE_STEP = 1e-7
 #: from float64's 1.8e308; a mesh beyond it is refused (its squares overflow) instead of turning into
 #: infinities and NaN deep in a solver. Scale such a mesh down first.
 MAX_ABS_COORDINATE = 1e40
+#: rows of a tanh output are clipped into [-TANH_ROW_CLIP, TANH_ROW_CLIP] before ``atanh`` where only a
+#: start is needed (``corrected_decoder``: the projection that starts a code's fit through the tanh).
+TANH_ROW_CLIP = 0.999
+#: principal directions computed through the Gram matrix (``corrected_decoder.principal_directions``)
+#: whose singular value is below this fraction of the largest are numerical noise (the Gram matrix
+#: squares the condition number: rounding leaves singular values near sqrt(eps) = 1.5e-8 of the largest).
+GRAM_RANK_RTOL = 1e-6

@@ -18,7 +18,7 @@ from meshvae_lib.geometry.boundaries import boundary_loops
 from meshvae_lib.geometry.topology import edges
 
 NAMES = [n for n, _ in list_collections()]
-CLOSED = {"scape", "dyna", "jumping", "hand", "face"}
+CLOSED = {"scape", "dyna", "jumping", "hand", "face", "poses"}
 #: boundary loops expected of each collection's template
 N_LOOPS = {"flag": 1, "bar": 2, **{n: 0 for n in CLOSED}}
 
@@ -262,11 +262,14 @@ def test_no_crossing_triangles_and_no_repeated_meshes(collections, name):
 #: size: rigid alignment takes the head's turn away, the rest is a few dozen smooth directions), and
 #: dyna (3e-4) and the hand (3e-4) reach 1e-4 but not the pose collections' 2e-3
 BELOW_POSE_TARGET = {"dyna", "hand"}
-LINEAR = {"face"}
+#: and the poses collection, at full rank: linear blend skinning makes every vertex a linear function
+#: of the moving bones' matrices, so its 960 training meshes span the held-out ones (about 200
+#: directions; it asks its question at latent sizes far below that: docs/results/nonlinearity.md)
+LINEAR = {"face", "poses"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(n in LINEAR, strict=True,
-                                                                          reason="linear data (issue 24)"))
+                                                                          reason="linear data at full rank (issue 24)"))
                                   for n in NAMES])
 def test_no_linear_projection_reproduces_a_collection(collections, name):
     """Held-out meshes (every 5th) lie at least FLOOR_TARGET of the diagonal from the span of the

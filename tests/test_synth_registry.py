@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import data_synth
+from data_synth import constants as C
 from data_synth import COLLECTIONS, list_collections, make_collection
 from data_synth.bar import BAR_MOTIONS
 from data_synth.bodies import DYNA_SHAPES
@@ -49,7 +50,7 @@ def test_default_sizes_and_types(name):
     col = built(name)  # the default collection, shared with the geometry tests
     N, V, _ = col.vertices.shape
     assert 500 <= V <= 3000, f"{name}: {V} vertices"
-    assert 20 <= N <= 250, f"{name}: {N} meshes"
+    assert 20 <= N <= (C.POSES_N if name == "poses" else 250), f"{name}: {N} meshes"
     assert col.vertices.dtype == np.float64 and col.faces.dtype == np.int64
     assert len(col.names) == N and len(set(col.names)) == N
     assert col.description
@@ -205,3 +206,34 @@ def test_bad_input_raises_value_error_showing_the_value(bad):
         make_collection(name, **bad)
     shown = str(list(bad.values())[0]) if bad else name
     assert shown in str(exc.value)
+
+
+def test_poses_have_sixteen_known_angles_within_their_ranges():
+    col = built("poses")
+    assert len(col) == C.POSES_N >= 1000
+    dof = col.extras["dof"]
+    assert dof.shape == (len(col), 16) and col.extras["dof_names"] == list(C.POSES_DOF)
+    low, high = np.array(list(C.POSES_DOF.values())).T
+    assert (dof >= low).all() and (dof <= high).all()
+    # every angle is drawn over its whole range, independently of the others
+    assert (dof.min(0) < low + 0.05 * (high - low)).all() and (dof.max(0) > high - 0.05 * (high - low)).all()
+    assert np.abs(np.corrcoef(dof.T) - np.eye(16)).max() < 0.15
+
+
+def test_poses_are_rebuilt_from_their_angles():
+    from data_synth.bodies import poses_dof
+
+    rng = np.random.default_rng(0)
+    pose, angles = poses_dof(40, rng)
+    assert angles.shape == (40, 16) and pose.local.shape[0] == 40
+    straight = np.flatnonzero(angles[:, list(C.POSES_DOF).index("l_elbow")] < 0.1)
+    bent = np.flatnonzero(angles[:, list(C.POSES_DOF).index("l_elbow")] > 1.2)
+    from data_synth.humanoid import NAMES
+
+    j = NAMES.index("l_forearm")
+    turn = np.degrees(np.arccos(np.clip((np.trace(pose.local[:, j], axis1=1, axis2=2) - 1) / 2, -1, 1)))
+    assert turn[straight].max() < turn[bent].min()
+    with pytest.raises(ValueError, match="n must be at least 1, got 0"):
+        poses_dof(0, rng)
+    with pytest.raises(ValueError, match="n_poses must be an integer >= 2, got 1"):
+        COLLECTIONS["poses"].build(seed=0, n_poses=1)
