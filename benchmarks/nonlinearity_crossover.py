@@ -19,8 +19,8 @@ comparison between the linear and the corrected decoder is what this benchmark m
 Two experiments:
 
 - ``--crossover`` (the ``poses`` collection: one body, 1,200 poses of 16 joint angles drawn
-  independently): the last 200 poses are held out; the decoders are trained on the first N of the
-  remaining 1,000 for N in ``--train-sizes``, at every latent size: where does the correction start
+  independently): the last ``--test-size`` poses (100) are held out; the decoders are trained on the
+  first N of the first 1,000 for N in ``--train-sizes``, at every latent size: where does the correction start
   to pay, in coordinates and in RIMD?
 - the collections (every 5th mesh held out, as ``meshvae train``): real captures from
   ``../shared/data`` (``name/k``: every k-th frame) and the synthetic stand-ins.
@@ -101,7 +101,8 @@ def _report(m: CorrectedLinearDecoder) -> dict:
     r = m.report_
     return {"linear_validation": r.linear_validation, "corrected_validation": r.corrected_validation,
             "linear_score": r.linear_score, "corrected_score": r.corrected_score,
-            "gain_lower_bound": r.gain_lower_bound,
+            "gain_lower_bound": r.gain_lower_bound, "linear_errors": r.linear_errors,
+            "corrected_errors": r.corrected_errors,
             "best_step": r.best_step, "steps": r.steps, "reason": r.reason}
 
 
@@ -114,7 +115,7 @@ def crossover(args) -> list[dict]:
     coll, _ = load("poses")
     V = np.asarray(coll.vertices, np.float64)
     test = np.zeros(len(V), bool)
-    test[-200:] = True
+    test[-args.test_size:] = True
     t = time.perf_counter()
     kind, X = rimd_features(V, coll.faces)
     print(f"poses: {len(V)} meshes, {V.shape[1]} vertices, RIMD K = {X.shape[1]} ({time.perf_counter() - t:.1f} s)",
@@ -191,6 +192,7 @@ def main(argv=None) -> int:
     p.add_argument("--latents", type=int, nargs="+", default=[2, 4, 8, 16, 32])
     p.add_argument("--train-sizes", type=int, nargs="+", default=[50, 100, 200, 500, 1000])
     p.add_argument("--kinds", default="coords,rimd")
+    p.add_argument("--test-size", type=int, default=100, help="--crossover: the last meshes held out")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--out", type=Path, default=None)

@@ -189,8 +189,8 @@ CORRECTION_CHECK_EVERY = 50
 CORRECTION_PATIENCE = 8
 CORRECTION_VALIDATION_EVERY = 5
 CORRECTION_MIN_GAIN = 0.02
-#: ... and how many standard errors of the mean gain per validation mesh it must clear (the
-#: validation meshes are few: at 50 training meshes, 5 choose).
-CORRECTION_CONFIDENCE = 2.0
+#: ... with this one-sided confidence (Student's t bound of the mean gain per choosing validation mesh;
+#: they are few: at 50 training meshes, 5).
+CORRECTION_CONFIDENCE = 0.975
 CORRECTION_RANK = 128
 CORRECTION_FIT_ITERATIONS = 60

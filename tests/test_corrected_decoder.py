@@ -56,7 +56,9 @@ def test_the_correction_pays_on_a_curved_set_and_never_on_noise():
     err = np.mean(np.sum((m.reconstruct(Y_new) - Y_new) ** 2, axis=1))
     lin = np.mean(np.sum((projection(Y, Y_new, 4) - Y_new) ** 2, axis=1))
     assert err < 0.5 * lin, (err, lin)
-    assert m.report_.corrected_score < m.report_.linear_score and m.report_.gain_lower_bound > 0
+    r = m.report_
+    assert r.corrected_score < r.linear_score and r.gain_lower_bound > 0.02 * r.linear_score
+    assert len(r.linear_errors) == len(r.corrected_errors) == r.n_validation // 2
     # isotropic noise has no curved set to find: the linear decoder comes back, refitted on all rows
     noise = np.random.default_rng(2).normal(size=(120, 30))
     n = CorrectedLinearDecoder(4, seed=0, hidden=(64, 64), max_steps=600).fit(noise)
@@ -132,6 +134,7 @@ def test_the_score_chooses():
     (dict(latent_dim=2, validation_every=1), "validation_every must be an integer >= 2, got 1"),
     (dict(latent_dim=2, output="sigmoid"), "output must be 'linear' or 'tanh', got 'sigmoid'"),
     (dict(latent_dim=2, lr=0.0), "lr must be positive, got 0.0"),
+    (dict(latent_dim=2, confidence=2.0), r"confidence must lie in \[0.5, 1\), got 2.0"),
 ])
 def test_bad_parameters_are_refused_showing_the_value(kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -148,3 +151,17 @@ def test_bad_rows_are_refused_showing_the_value():
         m.codes(np.zeros((2, 3)))
     with pytest.raises(ValueError, match="codes must have 2 components, got 3"):
         m.decode(np.zeros((2, 3)))
+
+
+def test_gain_lower_bound_is_the_t_bound():
+    from scipy.stats import t
+
+    from meshvae_lib.model.corrected_decoder import gain_lower_bound
+
+    g = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    # mean 3, std sqrt(2.5), t_0.975(4) = 2.776
+    assert gain_lower_bound(g, 0.975) == pytest.approx(3.0 - t.ppf(0.975, 4) * np.sqrt(2.5) / np.sqrt(5), rel=1e-12)
+    assert gain_lower_bound(g, 0.975) == pytest.approx(1.0367, abs=1e-4)
+    assert gain_lower_bound(np.full(4, 0.5), 0.99) == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="need at least 2 gains for a bound, got 1"):
+        gain_lower_bound([1.0], 0.9)

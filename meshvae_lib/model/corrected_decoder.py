@@ -16,8 +16,8 @@ that map from a few hundred meshes without memorising them. This estimator asks 
   rows set aside from the training rows: their codes are fitted to them with ``g`` frozen (as
   held-out meshes' codes are), and the network of the best error on half of them is kept;
 - the other half chooses: unless the corrected decoder's error there (in the measure the caller
-  gives, e.g. the vertex error) is below ``1 - min_gain`` times the linear decoder's, and its mean
-  gain per row clears ``confidence`` standard errors, the estimator returns the linear decoder,
+  gives, e.g. the vertex error) gains over the linear decoder's by more than ``min_gain`` of it with
+  the ``confidence`` of a one-sided t bound, the estimator returns the linear decoder,
   refitted on all rows. So a few lucky rows do not choose the correction, and where it is kept its
   gain was measured on rows that neither trained nor stopped it.
 
@@ -29,7 +29,7 @@ projection, then L-BFGS through the corrected decoder).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -40,7 +40,7 @@ from meshvae_lib.defaults import (CORRECTION_CHECK_EVERY, CORRECTION_CODE_PRIOR,
 from meshvae_lib.tolerances import GRAM_RANK_RTOL, TANH_ROW_CLIP
 from meshvae_lib.validation import check_is_fitted
 
-__all__ = ["CorrectedLinearDecoder", "CorrectionReport", "principal_directions"]
+__all__ = ["CorrectedLinearDecoder", "CorrectionReport", "gain_lower_bound", "principal_directions"]
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +71,17 @@ def principal_directions(Y: np.ndarray, max_rank: int) -> tuple[np.ndarray, np.n
     return mean, basis, s_r / np.sqrt(max(n - 1, 1))
 
 
+def gain_lower_bound(gain: np.ndarray, confidence: float) -> float:
+    """The one-sided ``confidence`` lower bound of the mean of ``gain (n >= 2,)`` float (Student's t
+    with n - 1 degrees of freedom): ``mean - t_q(n - 1) * std / sqrt(n)``."""
+    from scipy.stats import t
+
+    gain = np.asarray(gain, dtype=np.float64).reshape(-1)
+    if gain.size < 2:
+        raise ValueError(f"need at least 2 gains for a bound, got {gain.size}")
+    return float(gain.mean() - t.ppf(confidence, gain.size - 1) * gain.std(ddof=1) / np.sqrt(gain.size))
+
+
 @dataclass
 class CorrectionReport:
     """What :meth:`CorrectedLinearDecoder.fit` measured and chose.
@@ -81,8 +92,10 @@ class CorrectionReport:
     best_step, steps : the Adam step of the best validation error and the steps taken; n_fit,
     n_validation : the rows trained on and set aside; curve : (step, training error, validation
     error of the stopping rows) at every check; linear_score, corrected_score : the mean of ``score``
-    over the choosing rows for both decoders; gain_lower_bound : the mean gain per row less ``confidence`` standard
-    errors (the correction is kept only where it is above 0).
+    over the choosing rows for both decoders, and linear_errors, corrected_errors : their values row
+    by row; gain_lower_bound : the lower confidence bound of the mean gain per row
+    (:func:`gain_lower_bound`; the correction is kept only where it is above ``min_gain`` times the
+    linear decoder's mean error).
     """
 
     kept: str
@@ -97,6 +110,8 @@ class CorrectionReport:
     linear_score: float = float("nan")
     corrected_score: float = float("nan")
     gain_lower_bound: float = float("nan")
+    linear_errors: list = field(default_factory=list)
+    corrected_errors: list = field(default_factory=list)
 
 
 class CorrectedLinearDecoder:
@@ -117,9 +132,9 @@ class CorrectedLinearDecoder:
     validation_every : every k-th training row (from the ``k // 2``-th) is set aside for validation;
         alternately, those rows stop training (their error picks the best step) or choose between
         the corrected and the linear decoder (so that the choice is not biased by the pick).
-    min_gain, confidence : the corrected decoder is kept only if its validation score is below
-        ``(1 - min_gain)`` times the linear decoder's and the mean gain per validation row, less
-        ``confidence`` standard errors, is above 0 (a few lucky rows do not choose it).
+    min_gain, confidence : the corrected decoder is kept only if the one-sided ``confidence`` lower
+        bound of its mean gain per choosing row (Student's t) is above ``min_gain`` times the linear
+        decoder's mean error there (a few lucky rows do not choose it).
     rank : the most principal directions the correction writes into (r).
     fit_iterations : L-BFGS iterations when codes are fitted to rows.
     output : "linear" (rows are the decoder's output: vertex coordinates) or "tanh" (rows in (-1, 1)
@@ -168,7 +183,9 @@ class CorrectedLinearDecoder:
             raise ValueError(f"validation_every must be an integer >= 2, got {self.validation_every!r}")
         if any(isinstance(h, bool) or not isinstance(h, (int, np.integer)) or h < 1 for h in tuple(self.hidden)):
             raise ValueError(f"hidden must be positive integers, got {self.hidden!r}")
-        for name in ("weight_decay", "code_prior", "confidence"):
+        if not 0.5 <= float(self.confidence) < 1.0:
+            raise ValueError(f"confidence must lie in [0.5, 1), got {self.confidence!r}")
+        for name in ("weight_decay", "code_prior"):
             v = getattr(self, name)
             if not 0.0 <= float(v) < float("inf"):
                 raise ValueError(f"{name} must be finite and >= 0, got {v!r}")
@@ -286,17 +303,19 @@ class CorrectedLinearDecoder:
             e_lin = np.asarray(score(linear_rows, idx), dtype=np.float64).reshape(-1)
             e_cor = np.asarray(score(corrected_rows, idx), dtype=np.float64).reshape(-1)
         gain = e_lin - e_cor
-        bound = float(gain.mean() - float(self.confidence) * gain.std(ddof=1) / np.sqrt(len(gain)))
-        report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound)
-        if e_cor.mean() < (1.0 - float(self.min_gain)) * e_lin.mean() and bound > 0.0:
+        bound = gain_lower_bound(gain, float(self.confidence))
+        report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound,
+                      linear_errors=e_lin.tolist(), corrected_errors=e_cor.tolist())
+        if bound > float(self.min_gain) * e_lin.mean():
             self.report_ = CorrectionReport(
                 "corrected", f"validation error {e_cor.mean():.4g} against the linear decoder's "
-                f"{e_lin.mean():.4g} ({len(gain)} meshes; the gain's lower bound {bound:.3g} > 0)", **report)
+                f"{e_lin.mean():.4g} ({len(gain)} meshes; the gain's lower bound {bound:.3g} > "
+                f"{float(self.min_gain):.3g} x the linear error)", **report)
         else:
             self._keep_linear(Y, CorrectionReport(
                 "linear", f"the correction's validation error {e_cor.mean():.4g} against the linear decoder's "
-                f"{e_lin.mean():.4g} ({len(gain)} meshes): not below {1 - float(self.min_gain):.3g} x, or the "
-                f"gain's lower bound {bound:.3g} is not above 0", **report))
+                f"{e_lin.mean():.4g} ({len(gain)} meshes): the gain's lower bound {bound:.3g} is not above "
+                f"{float(self.min_gain):.3g} x the linear error", **report))
         log.info("corrected decoder (latent %d): kept the %s decoder (%s)", D, self.report_.kept, self.report_.reason)
         return self
 
