@@ -25,6 +25,11 @@ class InferenceStrategy:
         unconditional model); ``progress``: a progress bar over the meshes where the work is long."""
         raise NotImplementedError
 
+    def report(self) -> object | None:
+        """What the latest :meth:`infer` did (the estimator keeps it as ``last_inference_``), or
+        None: a strategy with nothing to report (the default)."""
+        return None
+
     def get_options(self) -> dict:
         """``{keyword: value}`` of the strategy's options (what rebuilds it)."""
         return {k: getattr(self, k) for k in self.options}
