@@ -35,6 +35,8 @@ def lazy_exports(package: str, names: dict[str, str]):
     return __getattr__, __dir__
 
 
-def exports_of(modules: dict[str, tuple[str, ...]]) -> dict[str, str]:
-    """``{module: (name, ...)}`` -> ``{name: module}``, the table :func:`lazy_exports` reads."""
-    return {name: module for module, names in modules.items() for name in names}
+def exports_of(package: str, table: str) -> dict[str, str]:
+    """``{name: module}`` from a table of lines ``module name name ...`` (modules relative to
+    ``package``, e.g. ``evaluation`` or ``inference.gauss_newton``), the form :func:`lazy_exports` reads."""
+    return {name: f"{package}.{module}" for module, *names in (line.split() for line in table.strip().splitlines())
+            for name in names}

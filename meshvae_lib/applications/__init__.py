@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from meshvae_lib.exports import exports_of, lazy_exports
 
-#: module -> the public names it defines (here as name -> module).
-EXPORTS = exports_of({
-    "meshvae_lib.applications.generation": ("mix_parts",),
-    "meshvae_lib.applications.interpolation": ("edge_length_distortion", "vertex_edge_stretch"),
-})
+#: module (under this package) and the public names it defines, one line each.
+EXPORTS = exports_of(__name__, """
+generation     mix_parts
+interpolation  edge_length_distortion vertex_edge_stretch
+""")
 
 __all__ = sorted(EXPORTS)
 

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 from meshvae_lib.exports import exports_of, lazy_exports
 
-#: module -> the public names it defines (here as name -> module).
-EXPORTS = exports_of({
-    "meshvae_lib.course.display": ("describe_model", "first_argmax", "local_parts_figure", "local_parts_table", "model_summary", "real_feature_table", "real_inference_table", "roundoff", "span_ceiling_table", "spiral_figure", "spiral_table"),
-    "meshvae_lib.course.models": ("course_model", "get_spec"),
-    "meshvae_lib.course.prior_costs": ("one_dimension_cost", "prior_cost_figure"),
-})
+#: module (under this package) and the public names it defines, one line each.
+EXPORTS = exports_of(__name__, """
+display      describe_model first_argmax local_parts_figure local_parts_table model_summary roundoff
+display      real_feature_table real_inference_table span_ceiling_table spiral_figure spiral_table
+models       course_model get_spec
+prior_costs  one_dimension_cost prior_cost_figure
+""")
 
 __all__ = sorted(EXPORTS)
 

@@ -8,25 +8,25 @@ from __future__ import annotations
 
 from meshvae_lib.exports import exports_of, lazy_exports
 
-#: module -> the public names it defines (here as name -> module).
-EXPORTS = exports_of({
-    "meshvae_lib.model.evaluation": ("evaluate_model", "pca_baseline", "per_vertex_error", "regional_pca_baseline"),
-    "meshvae_lib.model.feature_kinds": ("make_kind",),
-    "meshvae_lib.model.inference": ("make_inference",),
-    "meshvae_lib.model.inference.gauss_newton": ("FitState", "GaussNewton", "GaussNewtonReport", "LatentDecoder",
-                                                 "gauss_newton_codes", "marquardt_fit", "without_rigid_motions"),
-    "meshvae_lib.model.inplace_grad": ("start_step",),
-    "meshvae_lib.model.loss": ("kl_divergence", "vae_loss"),
-    "meshvae_lib.model.meshvae_model": ("MeshVAEModel", "load_model"),
-    "meshvae_lib.model.network_base": ("Network",),
-    "meshvae_lib.model.networks": ("ARCHITECTURES", "ReferenceMesh", "network_class"),
-    "meshvae_lib.model.normalization": ("FeatureNormalizer",),
-    "meshvae_lib.model.posterior": ("decoder_column_norms", "decoder_sigma"),
-    "meshvae_lib.model.threads": ("configure_threads",),
-    "meshvae_lib.model.train_config": ("TrainConfig",),
-    "meshvae_lib.model.training": ("holdout_mask", "train_vae"),
-    "meshvae_lib.model.vae": ("MeshVAE",),
-})
+#: module (under this package) and the public names it defines, one line each.
+EXPORTS = exports_of(__name__, """
+evaluation              evaluate_model pca_baseline per_vertex_error regional_pca_baseline
+feature_kinds           make_kind
+inference               make_inference
+inference.gauss_newton  FitState GaussNewton GaussNewtonReport LatentDecoder
+inference.gauss_newton  gauss_newton_codes marquardt_fit without_rigid_motions
+inplace_grad            start_step
+loss                    kl_divergence vae_loss
+meshvae_model           MeshVAEModel load_model
+network_base            Network
+networks                ARCHITECTURES ReferenceMesh network_class
+normalization           FeatureNormalizer
+posterior               decoder_column_norms decoder_sigma
+threads                 configure_threads
+train_config            TrainConfig
+training                holdout_mask train_vae
+vae                     MeshVAE
+""")
 
 __all__ = sorted(EXPORTS)
 

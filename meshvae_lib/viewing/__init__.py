@@ -41,24 +41,24 @@ from meshvae_lib.viewing.one_ring_figure import one_ring_figure
 from meshvae_lib.viewing.pipeline_diagram import pipeline_diagram
 from meshvae_lib.viewing.readable_figure import readable_figure
 
-#: module -> the public names it defines (here as name -> module).
-EXPORTS = exports_of({
-    "meshvae_lib.viewing.buffers": ("position_buffer", "normal_buffer", "index_buffer", "color_buffer", "row_offsets", "fit_camera"),
-    "meshvae_lib.viewing.colors": ("ColorMapping", "scalar_colors", "error_colors", "label_colors", "colorbar_html", "legend_html"),
-    "meshvae_lib.viewing.gallery": ("gallery_indices", "mesh_caption", "angular_stripes"),
-    "meshvae_lib.viewing.render": ("render_mesh", "render_mesh_grid", "figure_to_png"),
-    "meshvae_lib.viewing.fallback": ("resolve_mode", "ImageView"),
-    "meshvae_lib.viewing.viewer": ("MeshViewer",),
-    "meshvae_lib.viewing.widgets": ("FramePlayer", "InterpolationSlider"),
-    "meshvae_lib.viewing.explorer": ("LatentExplorer",),
-    "meshvae_lib.viewing.latent_pad": ("LatentPad",),
-    "meshvae_lib.viewing.convergence_curves": ("convergence_figure", "epochs_past_best"),
-    "meshvae_lib.viewing.embedding_maps": ("embedding_maps_figure",),
-    "meshvae_lib.viewing.interpolation_measures": ("interpolation_measures_figure",),
-    "meshvae_lib.viewing.marked_vertices": ("marked_vertices_figure",),
-    "meshvae_lib.viewing.normalization_margins": ("normalization_margin_figure",),
-    "meshvae_lib.viewing.rimd_diagrams": ("feature_layout_figure", "polar_decomposition_figure"),
-})
+#: module (under this package) and the public names it defines, one line each.
+EXPORTS = exports_of(__name__, """
+buffers                 position_buffer normal_buffer index_buffer color_buffer row_offsets fit_camera
+colors                  ColorMapping scalar_colors error_colors label_colors colorbar_html legend_html
+gallery                 gallery_indices mesh_caption angular_stripes
+render                  render_mesh render_mesh_grid figure_to_png
+fallback                resolve_mode ImageView
+viewer                  MeshViewer
+widgets                 FramePlayer InterpolationSlider
+explorer                LatentExplorer
+latent_pad              LatentPad
+convergence_curves      convergence_figure epochs_past_best
+embedding_maps          embedding_maps_figure
+interpolation_measures  interpolation_measures_figure
+marked_vertices         marked_vertices_figure
+normalization_margins   normalization_margin_figure
+rimd_diagrams           feature_layout_figure polar_decomposition_figure
+""")
 
 __all__ = sorted([*EXPORTS, "network_diagram", "one_ring_figure", "pipeline_diagram", "readable_figure"])
 
