@@ -149,9 +149,9 @@ class LocalPartsVAE(MeshVAE):
 
     @classmethod
     def check_config(cls, config) -> None:
-        """The latent size (``config.latent_dim``, or the architecture's default when unset) must
-        split into the regions."""
-        check_regions(config.latent_dim or cls.train_defaults["latent_dim"], cls.options(config).n_regions)
+        """The latent size (``config.nominal_latent_dim()``: the architecture's default when unset)
+        must split into the regions."""
+        check_regions(config.nominal_latent_dim(), cls.options(config).n_regions)
 
     @classmethod
     def weights_estimate(cls, n_features: int, config) -> None:

@@ -376,7 +376,7 @@ class MeshVAEModel:
         net = self.network_
         arch = "" if net.architecture == DEFAULT_ARCHITECTURE else f", architecture={net.architecture!r}"
         return (f"MeshVAEModel(features={self.kind_.name!r}, n_vertices={self.kind_.n_vertices},"
-                f" K={net.n_features}, latent={net.latent_dim}, hidden={list(net.config().get('hidden', []))}"
+                f" K={net.n_features}, latent={net.latent_dim}, hidden={list(self.train_config_.hidden)}"
                 f"{arch}, conditions={self.conditions_.columns})")
 
 

@@ -149,12 +149,17 @@ class TrainConfig:
 
     def resolved_latent_dim(self, n_rows: int, n_conditions: int = 0) -> int:
         """D for a new network trained on ``n_rows`` rows (see ``latent_dim``)."""
+        if self.latent_dim is None and "latent_dim" not in network_class(self.architecture).train_defaults \
+                and self.uses_pca_init(n_conditions):
+            return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
+        return self.nominal_latent_dim()
+
+    def nominal_latent_dim(self) -> int:
+        """D before the rows are known: ``latent_dim``, or the architecture's default (the PCA start
+        may choose more, :meth:`resolved_latent_dim`)."""
         if self.latent_dim is not None:
             return int(self.latent_dim)
-        own = network_class(self.architecture).train_defaults.get("latent_dim")
-        if own is None and self.uses_pca_init(n_conditions):
-            return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
-        return int(DEFAULT_LATENT if own is None else own)
+        return int(network_class(self.architecture).train_defaults.get("latent_dim", DEFAULT_LATENT))
 
     def resolved_a(self, n_conditions: int = 0) -> float:
         """a of Eq. 3 (see ``a``)."""
@@ -224,9 +229,9 @@ class TrainConfig:
         for name, ok in checks.items():
             if not ok:
                 raise ValueError(f"TrainConfig.{name} is out of range: {asdict(self)[name]!r}")
-        latent = self.latent_dim or net.train_defaults.get("latent_dim", DEFAULT_LATENT)
-        if self.sigma_object is not None and len(self.sigma_object) > latent:
-            raise ValueError(f"TrainConfig.sigma_object has {len(self.sigma_object)} values, more than latent_dim {latent}")
+        if self.sigma_object is not None and len(self.sigma_object) > self.nominal_latent_dim():
+            raise ValueError(f"TrainConfig.sigma_object has {len(self.sigma_object)} values, more than latent_dim"
+                             f" {self.nominal_latent_dim()}")
         net.check_config(self)
 
     def to_dict(self) -> dict:
