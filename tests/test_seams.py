@@ -130,6 +130,7 @@ def test_a_new_network_is_one_module_and_one_registry_line(plug_in, monkeypatch,
     np.testing.assert_array_equal(loaded.generate(2, seed=3), model.generate(2, seed=3))
     saved = torch.load(tmp_path / "toy.pt", weights_only=True)
     assert saved["architecture"] == "toy-linear" and saved["train_config"]["network_options"] == {"floor": 0.01}
+    assert (saved["train_config"]["latent_dim"], saved["train_config"]["a"]) == (2, 0.9)      # the resolved config
     fitted = evaluate_model(loaded, coll, held_out_only=True, inference="finite-difference")  # any inference works on it
     assert fitted["fit_iterations"] == 4      # the finite-difference default (GAUSS_NEWTON_ITERATIONS)
     # the default inference too: the decoder's Jacobian comes from autograd, nothing written for it
