@@ -43,10 +43,9 @@ from meshvae_lib.paper.features import feature_table
 from meshvae_lib.paper.generation import generation_table
 from meshvae_lib.paper.interpolation import interpolation_table
 from meshvae_lib.paper.latent_size import latent_size_table
-from meshvae_lib.paper.linear_floor import NOT_INFORMATIVE, informative_rows, linear_floor
+from meshvae_lib.paper.linear_floor import informative_rows, linear_floor
 from meshvae_lib.paper.loss import loss_table
 from meshvae_lib.paper.noise_diversity import noise_diversity_table
-from meshvae_lib.paper.plots import plot_validation_curves
 from meshvae_lib.paper.protocol import collection_fingerprint, load_collection
 from meshvae_lib.paper.robustness import robustness_table
 from meshvae_lib.paper.settings import PAPER, ExperimentSettings
@@ -60,8 +59,6 @@ __all__ = [
     "load_collection",
     "linear_floor",
     "informative_rows",
-    "NOT_INFORMATIVE",
-    "plot_validation_curves",
     "latent_size_table",
     "feature_table",
     "robustness_table",

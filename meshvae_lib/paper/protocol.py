@@ -115,7 +115,7 @@ def train_model(coll: MeshCollection, settings: ExperimentSettings, cache: dict 
 
     ``prior`` (only with ``sigma_object``): "sibling" -- the authors' sibling-code formula (posterior
     widths shrink, means keep unit spread), or "exact" -- the exact KL to N(0, diag sigma_object^2);
-    see ``loss.kl_divergence``. ``hidden``, ``alpha``, ``seed``: override the defaults (the feature
+    see ``vae.kl_divergence``. ``hidden``, ``alpha``, ``seed``: override the defaults (the feature
     kind's ``default_hidden``, the paper's alpha = 1e6, the settings' seed). ``loss``: "mse" (Eq. 4)
     or "bce" (sigmoid output, binary cross-entropy; Sec. 5.1).
     """
