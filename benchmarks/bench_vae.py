@@ -20,7 +20,8 @@ import torch
 from meshvae_lib.model.train_config import TrainConfig
 from meshvae_lib.model.training import train_vae
 from meshvae_lib.model.inplace_grad import start_step
-from meshvae_lib.model.vae import MeshVAE, vae_loss
+from meshvae_lib.model.loss import vae_loss
+from meshvae_lib.model.vae import MeshVAE
 
 
 def rimd_k(n_vertices: int) -> int:

@@ -40,11 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from meshvae_lib.model.corrected_decoder import CorrectedLinearDecoder, principal_directions
-from meshvae_lib.model.evaluation import per_vertex_error
-from meshvae_lib.model.feature_kinds import make_kind
-from meshvae_lib.model.normalization import FeatureNormalizer
-from meshvae_lib.model.training import holdout_mask
+from meshvae_lib.model import (CorrectedLinearDecoder, FeatureNormalizer, holdout_mask, make_kind, per_vertex_error,
+                               principal_directions)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from spiral_comparison import load  # noqa: E402

@@ -9,14 +9,17 @@ The face of the library, for scripts and notebooks::
     model.save("model.pt"); model = mv.load_model("model.pt", coll)
 
 The same names live in small modules, one concept each (``meshvae_lib.geometry.rimd``,
-``meshvae_lib.model.meshvae_model``, ...); :data:`FACADE` says where. Importing the package does
-no work: each name is imported from its module the first time it is used, so ``import meshvae_lib``
-pulls in neither torch nor pythreejs.
+``meshvae_lib.model.meshvae_model``, ...); :data:`FACADE` says where. Each first-level subpackage
+(``geometry``, ``model``, ``applications``, ``viewing``, ``course``, ``paper``) exports its public
+names the same way: ``from meshvae_lib.model import MeshVAEModel, evaluate_model``. Importing the
+package does no work: each name is imported from its module the first time it is used
+(:func:`~meshvae_lib.exports.lazy_exports`), so ``import meshvae_lib`` pulls in neither torch nor
+pythreejs.
 """
 
 from __future__ import annotations
 
-import importlib
+from meshvae_lib.exports import lazy_exports
 
 __version__ = "0.1.0"
 
@@ -36,14 +39,4 @@ FACADE = {
 __all__ = ["__version__", *FACADE]
 
 
-def __getattr__(name: str):
-    module = FACADE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'meshvae_lib' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(FACADE))
+__getattr__, __dir__ = lazy_exports(__name__, FACADE)

@@ -17,12 +17,12 @@ DEFAULT_ARCHITECTURE = "mesh-vae"
 LAYOUTS = ("paper", "compact")
 #: the RIMD layout unless told otherwise: the paper's.
 DEFAULT_LAYOUT = "paper"
-#: how a sigma_object prior enters the latent cost (``vae.kl_divergence``).
+#: how a sigma_object prior enters the latent cost (``loss.kl_divergence``).
 PRIOR_FORMS = ("exact", "sibling")
 #: the decoder's last activation: the mesh VAE's tanh or sigmoid (``vae.MeshVAE(output=...)``), or none
 #: ("linear": the spiral network's, ``spiral_net.SpiralVAE``).
 OUTPUTS = ("tanh", "sigmoid", "linear")
-#: the reconstruction terms of ``vae.vae_loss`` (``loss=...``; "bce" needs the sigmoid output; "l1" is
+#: the reconstruction terms of ``loss.vae_loss`` (``loss=...``; "bce" needs the sigmoid output; "l1" is
 #: SpiralNet++'s).
 LOSSES = ("mse", "bce", "l1")
 #: the feature kinds whose rows are vertex positions (x0, y0, z0, x1, ...): what a network on the

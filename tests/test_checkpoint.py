@@ -216,8 +216,10 @@ def test_fitting_the_codes_to_the_vertices_never_raises_the_error(collection):
 def test_fit_leaves_its_constructor_arguments_and_exposes_the_mesh(collection):
     model = MeshVAEModel("coords", None, holdout_every=4)
     model.fit(collection)
-    # defaults used, argument kept; the latent size resolved (few meshes: the paper's 128)
-    assert model.config is None and model.train_config_ == replace(TrainConfig(), latent_dim=128)
+    # defaults used, argument kept; the configuration resolved once (few meshes: the paper's 128; the PCA
+    # start's a = 0.3 and the coordinates' shared half-width), and that is what the checkpoint records
+    assert model.config is None
+    assert model.train_config_ == replace(TrainConfig(), latent_dim=128, a=0.3, feature_scale="shared")
     assert TrainConfig().latent_dim is None and model.latent_dim == 128
     np.testing.assert_array_equal(model.reference_vertices, collection.vertices[0])
     np.testing.assert_array_equal(model.faces, collection.faces)

@@ -243,6 +243,17 @@ def test_train_a_spiral_network_from_the_command_line(tmp_path, capsys):
     assert main(["train", str(small), "-o", str(tmp_path / "y.pt"), "--architecture", "spiral", "--epochs", "1",
                  "--no-progress"]) == 2
     assert "too few for down-sampling" in capsys.readouterr().err
+    # its options are flags (from its Options dataclass) and reach the network
+    assert main(["train", str(path), "-o", str(tmp_path / "small.pt"), "--architecture", "spiral", "--epochs", "1",
+                 "--latent", "2", "--channels", "8", "4", "--factors", "4", "4", "--spiral-length", "5",
+                 "--no-progress"]) == 0
+    net = load_model(tmp_path / "small.pt", coll).network
+    assert (net.channels, net.spiral_length, len(net.level_sizes)) == ([8, 4], 5, 3)
+    capsys.readouterr()
+    assert main(["train", str(path), "-o", str(tmp_path / "z.pt"), "--channels", "8"]) == 2
+    assert "--channels is the spiral network's, not mesh-vae's" in capsys.readouterr().err
+    assert main(["train", str(path), "-o", str(tmp_path / "z.pt"), "--architecture", "spiral", "--spiral-length", "0"]) == 2
+    assert "--spiral-length" in capsys.readouterr().err and not (tmp_path / "z.pt").exists()
 
 
 def test_train_a_local_parts_network_from_the_command_line(tmp_path, capsys):

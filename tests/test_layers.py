@@ -1,6 +1,6 @@
 """The folders are the layers: no module imports from a layer above its own.
 
-geometry -> model -> applications -> paper, with the base modules (tolerances, defaults,
+geometry -> model -> applications -> paper, with the base modules (tolerances, defaults, exports,
 validation, input_checks, progress, atomic) under all of them; viewing sits beside the model on top of geometry alone (it draws
 meshes, whatever made them); course and cli are the top. Every import counts, also those inside
 functions (lazy imports are how the CLI starts fast, not a way around the layers).
@@ -15,7 +15,8 @@ import pytest
 
 LIB = Path(__file__).resolve().parents[1] / "meshvae_lib"
 
-BASE = {"tolerances", "defaults", "validation", "input_checks", "progress", "atomic", "workers", "__init__", "__version__"}
+BASE = {"tolerances", "defaults", "validation", "input_checks", "progress", "atomic", "workers", "exports", "__init__",
+        "__version__"}
 #: layer -> the layers its modules may import from (its own included)
 ALLOWED = {
     "base": {"base"},

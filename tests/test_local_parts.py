@@ -188,10 +188,12 @@ def test_training_keeps_the_blocks_and_the_checkpoint_keeps_the_regions(two_ends
 
 def test_the_latent_size_must_be_a_multiple_of_the_regions(two_ends):
     coll, _ = two_ends
-    cfg = TrainConfig(architecture="local-parts", latent_dim=3, network_options={"n_regions": 2}, progress=False,
-                      device="cpu")
-    with pytest.raises(ValueError, match="multiple of n_regions, got 3 and 2"):
-        MeshVAEModel("rimd", cfg, holdout_every=5).fit(coll)
+    with pytest.raises(ValueError, match="latent_dim 3 is not a multiple of n_regions 2"):     # when the config is made
+        TrainConfig(architecture="local-parts", latent_dim=3, network_options={"n_regions": 2})
+    with pytest.raises(ValueError, match="latent_dim 128 is not a multiple of n_regions 3"):   # the default latent size
+        TrainConfig(architecture="local-parts", network_options={"n_regions": 3})
+    with pytest.raises(ValueError, match="latent_dim 3 is not a multiple of n_regions 2"):     # and the network itself
+        LocalPartsVAE(10, latent_dim=3, n_regions=2)
     with pytest.raises(ValueError, match="n_regions"):
         TrainConfig(architecture="local-parts", network_options={"regions": 2})
 

@@ -5,7 +5,8 @@ import pytest
 import torch
 
 from meshvae_lib.model.posterior import decoder_column_norms, decoder_sigma, linear_gaussian_sigma
-from meshvae_lib.model.vae import MeshVAE, vae_loss
+from meshvae_lib.model.loss import vae_loss
+from meshvae_lib.model.vae import MeshVAE
 
 torch.set_num_threads(1)
 

@@ -19,53 +19,47 @@ from meshvae_lib.model.train_config import TrainConfig
 torch.set_num_threads(1)
 
 TOY_NETWORK = '''
-import numpy as np
+from dataclasses import dataclass, field
+
 import torch
 from torch import nn
 
+from meshvae_lib.model.network_base import Network
 
-class LinearVAE(nn.Module):
+
+@dataclass(frozen=True)
+class ToyOptions:
+    floor: float = field(default=1e-3, metadata={"flag": "--toy-floor", "help": "the softplus deviation's floor"})
+
+
+class LinearVAE(Network):
     """A toy architecture: one linear map each way, softplus deviations."""
 
     architecture = "toy-linear"
-    output = "tanh"
+    description = "a toy: one linear map each way"
+    Options = ToyOptions
+    conditional = True
 
-    def __init__(self, n_features, latent_dim, n_conditions=0):
+    def __init__(self, n_features, latent_dim, n_conditions=0, floor=1e-3):
         super().__init__()
-        self.n_features, self.latent_dim, self.n_conditions = n_features, latent_dim, n_conditions
+        self.n_features, self.latent_dim, self.n_conditions, self.floor = n_features, latent_dim, n_conditions, floor
         self.enc = nn.Linear(n_features + n_conditions, 2 * latent_dim)
         self.dec = nn.Linear(latent_dim + n_conditions, n_features)
 
     @classmethod
-    def from_config(cls, config):
-        return cls(**config)
-
-    @classmethod
     def start(cls, x, n_conditions, config, mesh):
-        return cls(x.shape[1], config.latent_dim, n_conditions)
+        return cls(x.shape[1], config.latent_dim, n_conditions, cls.options(config).floor)
 
     def config(self):
-        return {"n_features": self.n_features, "latent_dim": self.latent_dim, "n_conditions": self.n_conditions}
-
-    def used_latent_dims(self):
-        return np.arange(self.latent_dim)
-
-    def _with(self, x, c):
-        return x if c is None else torch.cat([x, c], 1)
+        return {"n_features": self.n_features, "latent_dim": self.latent_dim, "n_conditions": self.n_conditions,
+                "floor": self.floor}
 
     def encode(self, x, c=None):
-        out = self.enc(self._with(x, c))
-        return out[:, :self.latent_dim], nn.functional.softplus(out[:, self.latent_dim:]) + 1e-3
-
-    def reparameterize(self, mu, sigma, generator=None):
-        return mu + sigma * torch.randn(mu.shape, generator=generator)
+        out = self.enc(self.with_condition(x, c, self.n_features, "features"))
+        return out[:, :self.latent_dim], nn.functional.softplus(out[:, self.latent_dim:]) + self.floor
 
     def decode(self, z, c=None):
-        return torch.tanh(self.dec(self._with(z, c)))
-
-    def forward(self, x, c=None, generator=None):
-        mu, sigma = self.encode(x, c)
-        return self.decode(self.reparameterize(mu, sigma, generator), c), mu, sigma
+        return torch.tanh(self.dec(self.with_condition(z, c, self.latent_dim, "latent vectors")))
 '''
 
 TOY_INFERENCE = '''
@@ -112,19 +106,31 @@ def plug_in(tmp_path, monkeypatch):
         sys.modules.pop(name, None)
 
 
-def test_a_new_network_is_one_module_and_one_registry_line(plug_in, monkeypatch, tmp_path):
+def test_a_new_network_is_one_module_and_one_registry_line(plug_in, monkeypatch, tmp_path, capsys):
+    """A fourth network: one module (written here) and one registry line, nothing else edited. It
+    trains, saves, loads, runs Gauss-Newton, evaluate, generate and interpolate, and ``meshvae train``
+    offers its options as flags."""
+    from meshvae_lib.applications.interpolation import LatentPath
+    from meshvae_lib.cli import main
+    from meshvae_lib.geometry.collection_io import write_collection
+
     plug_in("toy_network", TOY_NETWORK)
     monkeypatch.setitem(networks.ARCHITECTURES, "toy-linear", "toy_network:LinearVAE")   # the one line
     coll = _strips()
-    cfg = TrainConfig(architecture="toy-linear", init="random", epochs=3, latent_dim=2, batch_size=4, progress=False)
+    cfg = TrainConfig(architecture="toy-linear", init="random", epochs=3, latent_dim=2, batch_size=4, progress=False,
+                      network_options={"floor": 0.01})
     model = MeshVAEModel("coords", cfg, holdout_every=4).fit(coll)
     assert type(model.network).__name__ == "LinearVAE" and isinstance(model.network, networks.Network)
-    assert model.latent_dim == 2 and "architecture='toy-linear'" in repr(model)
+    assert model.latent_dim == 2 and model.network.floor == 0.01 and "architecture='toy-linear'" in repr(model)
+    assert model.train_config_.latent_dim == 2 and model.train_config_.a == 0.9     # resolved once, recorded
     loaded = load_model(model.save(tmp_path / "toy.pt"), coll)
-    assert type(loaded.network).__name__ == "LinearVAE"
+    assert type(loaded.network).__name__ == "LinearVAE" and loaded.network.floor == 0.01
     z = model.sample_latent(3, seed=1)
     np.testing.assert_array_equal(loaded.decode_latent(z), model.decode_latent(z))
-    assert torch.load(tmp_path / "toy.pt", weights_only=True)["architecture"] == "toy-linear"
+    np.testing.assert_array_equal(loaded.generate(2, seed=3), model.generate(2, seed=3))
+    saved = torch.load(tmp_path / "toy.pt", weights_only=True)
+    assert saved["architecture"] == "toy-linear" and saved["train_config"]["network_options"] == {"floor": 0.01}
+    assert (saved["train_config"]["latent_dim"], saved["train_config"]["a"]) == (2, 0.9)      # the resolved config
     fitted = evaluate_model(loaded, coll, held_out_only=True, inference="finite-difference")  # any inference works on it
     assert fitted["fit_iterations"] == 4      # the finite-difference default (GAUSS_NEWTON_ITERATIONS)
     # the default inference too: the decoder's Jacobian comes from autograd, nothing written for it
@@ -132,6 +138,22 @@ def test_a_new_network_is_one_module_and_one_registry_line(plug_in, monkeypatch,
     default = evaluate_model(loaded, coll, held_out_only=True, inference="gauss-newton")
     assert default["mean_vertex_error"] <= encoder["mean_vertex_error"] * (1 + 1e-9)
     assert default["mean_vertex_error"] < 0.9 * encoder["mean_vertex_error"]      # and it does something
+    assert loaded.last_inference_.final_error.shape == (4,)                   # the strategy's declared report
+    codes = loaded.encode_meshes(coll.vertices[[0, 5]])
+    _, meshes = LatentPath(loaded.decode_latent, codes[0], codes[1]).steps(4)
+    assert meshes.shape == (4, 18, 3) and np.allclose(meshes[0], loaded.decode_latent(codes[0]), atol=1e-6)
+    # its options are flags of `meshvae train`, and the flag reaches the network
+    with pytest.raises(SystemExit):
+        main(["train", "--help"])
+    text = capsys.readouterr().out
+    assert "toy-linear: a toy: one linear map each way" in " ".join(text.split())
+    assert "--toy-floor" in text and "toy-linear: the softplus deviation's floor (default 0.001)" in " ".join(text.split())
+    path = write_collection(tmp_path / "s.npz", coll)
+    assert main(["train", str(path), "-o", str(tmp_path / "cli.pt"), "--architecture", "toy-linear", "--features",
+                 "coords", "--toy-floor", "0.05", "--latent", "2", "--epochs", "2", "--no-progress"]) == 0
+    assert load_model(tmp_path / "cli.pt", coll).network.floor == 0.05
+    assert main(["train", str(path), "-o", str(tmp_path / "x.pt"), "--toy-floor", "0.05"]) == 2
+    assert "--toy-floor is the toy-linear network's, not mesh-vae's" in capsys.readouterr().err
     rows, J = networks.decoder_linearization(loaded.network, z[0])
     h = 1e-3
     fd = np.stack([(loaded.network.decode(torch.tensor(z[:1] + h * e, dtype=torch.float32))[0].detach().double().numpy()

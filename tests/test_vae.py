@@ -7,7 +7,8 @@ import pytest
 import torch
 
 from meshvae_lib.model.inplace_grad import Linear, start_step
-from meshvae_lib.model.vae import MeshVAE, kl_divergence, vae_loss
+from meshvae_lib.model.loss import kl_divergence, vae_loss
+from meshvae_lib.model.vae import MeshVAE
 
 torch.set_num_threads(1)  # tiny models: one thread is faster on the shared 2-core machine
 

@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import logging
 import re
 
 from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
-from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS, SPIRAL_EPOCHS, SPIRAL_LATENT
-from meshvae_lib.defaults import LOCAL_PARTS_LATENT, LOCAL_PARTS_METHOD, LOCAL_PARTS_REGIONS, REGION_METHODS
+from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
-from meshvae_lib.model.networks import ARCHITECTURE_NAMES
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
                check_at_most, check_number, check_output, note, result)
 
@@ -55,13 +54,15 @@ OPTIONS = {"epochs": "--epochs", "batch_size": "--batch-size", "lr": "--lr", "al
            "early_stopping": "--no-early-stopping", "progress": "--no-progress", "architecture": "--architecture"}
 
 
-def _option_names(text: str) -> str:
+def _option_names(text: str, flags: dict | None = None) -> str:
     """A library message with ``TrainConfig.<field>`` (or ``sigma_object``, ...) in the command
-    line's words: ``--epochs``."""
-    text = re.sub(r"TrainConfig\.(\w+)", lambda m: OPTIONS.get(m.group(1), m.group(0)), text)
-    return re.sub(r"\b(sigma_object|latent_dim|batch_size|holdout_every|reference_index)\b",
+    line's words: ``--epochs``; ``flags`` maps the networks' option fields to their flags."""
+    names = {**OPTIONS, **(flags or {})}
+    text = re.sub(r"TrainConfig\.(\w+)", lambda m: names.get(m.group(1), m.group(0)), text)
+    words = ["sigma_object", "latent_dim", "batch_size", "holdout_every", "reference_index", *(flags or {})]
+    return re.sub(r"\b(" + "|".join(map(re.escape, words)) + r")\b",
                   lambda m: {"holdout_every": "--holdout-every", "reference_index": "--reference"}.get(
-                      m.group(1), OPTIONS.get(m.group(1), m.group(1))), text)
+                      m.group(1), names.get(m.group(1), m.group(1))), text)
 
 
 def _check_device(text: str) -> None:
@@ -93,73 +94,113 @@ def _check_device(text: str) -> None:
         raise UsageError(f"--device {text}: devices of type {dev.type!r} are not supported (auto, cpu, cuda, mps)")
 
 
-def _network_parameters(n_features: int, hidden, latent: int) -> int:
-    """About how many weights the encoder and the decoder of a network have (K -> hidden -> 2 x
-    latent, latent -> hidden reversed -> K)."""
-    sizes = [n_features, *hidden]
-    enc = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * 2 * latent
-    dec = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * latent
-    return enc + dec
+# -- the networks' flags --------------------------------------------------------------------------
+# They come from the registered network classes (their ``description``, ``Options`` dataclass and
+# declared members), which import torch: the train command's parser adds them when it parses, so
+# that the other commands and ``meshvae --help`` start without torch.
 
 
-def _network_choices(args) -> tuple[int, ...]:
-    """Check ``--architecture`` against ``--features``, ``--hidden`` and ``--labels`` (setting the
-    architecture's default feature kind when none is given); returns the internal layer sizes."""
-    from meshvae_lib.model.networks import network_class
+def _flag(f: dataclasses.Field) -> str:
+    """The command line's name of an ``Options`` field: its ``metadata["flag"]`` or ``--field-name``."""
+    return f.metadata.get("flag", "--" + f.name.replace("_", "-"))
+
+
+def _option_flags() -> dict:
+    """flag -> (the architectures whose ``Options`` have it, its dataclass field), every registered network."""
+    from meshvae_lib.model.networks import ARCHITECTURES, network_class
+
+    flags: dict = {}
+    for name in ARCHITECTURES:
+        for f in dataclasses.fields(network_class(name).Options):
+            owners, _ = flags.get(_flag(f), ((), f))
+            flags[_flag(f)] = (owners + (name,), f)
+    return flags
+
+
+def _add_network_arguments(p: argparse.ArgumentParser) -> None:
+    """``--architecture`` (every registered network, with its description) and each network's
+    options as flags (default None: the network's own default)."""
+    from meshvae_lib.model.networks import ARCHITECTURES, network_class
+
+    p.add_argument("--architecture", choices=tuple(ARCHITECTURES), default=DEFAULT_ARCHITECTURE,
+                   help=f"the network (default {DEFAULT_ARCHITECTURE}): " + "; ".join(
+                       f"{name}: {network_class(name).description}" for name in ARCHITECTURES))
+    group = p.add_argument_group("the networks' options", "each network's own options (default: the network's)")
+    for flag, (owners, f) in _option_flags().items():
+        default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+        kwargs = {"dest": "network_" + f.name, "default": None}
+        if isinstance(default, (tuple, list)):       # a sequence: one or more values of its items' type
+            kwargs.update(nargs="+", type=type(default[0]) if default else int)
+            default = " ".join(map(str, default))
+        else:
+            kwargs.update(type=type(default))
+        if "choices" in f.metadata:
+            kwargs["choices"] = f.metadata["choices"]
+        else:
+            kwargs["metavar"] = f.metadata.get("metavar", f.name.upper())
+        group.add_argument(flag, help=f"{' and '.join(owners)}: {f.metadata.get('help', f.name)} (default {default})",
+                           **kwargs)
+
+
+class _TrainParser(argparse.ArgumentParser):
+    """The train command's parser: the networks' flags are added on its first parse (or help)."""
+
+    def parse_known_args(self, args=None, namespace=None):
+        if not any(a.dest == "architecture" for a in self._actions):
+            _add_network_arguments(self)
+        return super().parse_known_args(args, namespace)
+
+
+def _network_options(args, network) -> tuple[dict, dict]:
+    """``TrainConfig.network_options`` from the flags given, and the map from the networks' option
+    fields to their flags; UsageError for a flag of another network's."""
+    flags, options = _option_flags(), {}
+    for flag, (owners, f) in flags.items():
+        value = vars(args)["network_" + f.name]
+        if value is None:
+            continue
+        if network.architecture not in owners:
+            raise UsageError(f"{flag} is the {' and '.join(owners)} network's, not {network.architecture}'s")
+        options[f.name] = value
+    return options, {f.name: flag for flag, (_, f) in flags.items()}
+
+
+def _network_choices(args, network) -> tuple[int, ...]:
+    """Check the network (``--architecture``'s class) against ``--features``, ``--hidden`` and
+    ``--labels`` (setting its default feature kind when none is given); returns the internal layer sizes."""
+    from meshvae_lib.model.networks import ARCHITECTURES, network_class
     from meshvae_lib.model.train_config import default_hidden
 
-    net_kinds = getattr(network_class(args.architecture), "kinds", None)
     if args.features is None:
-        args.features = net_kinds[0] if net_kinds else DEFAULT_FEATURE_KIND
-    if net_kinds and args.features not in net_kinds:
-        raise UsageError(f"--architecture {args.architecture} works on --features {' or '.join(net_kinds)},"
+        args.features = network.kinds[0] if network.kinds else DEFAULT_FEATURE_KIND
+    if network.kinds and args.features not in network.kinds:
+        raise UsageError(f"--architecture {args.architecture} works on --features {' or '.join(network.kinds)},"
                          f" not {args.features}")
-    if args.architecture == DEFAULT_ARCHITECTURE:
+    if args.labels and not network.conditional:
+        raise UsageError(f"--architecture {args.architecture} is unconditional: no --labels")
+    if network.takes_hidden:
         return tuple(args.hidden) if args.hidden is not None else default_hidden(args.features, args.init)
     if args.hidden:
-        raise UsageError(f"--hidden is the {DEFAULT_ARCHITECTURE} network's; --architecture {args.architecture} has its own layers")
-    if args.labels:
-        raise UsageError(f"--architecture {args.architecture} is unconditional: no --labels")
+        takers = [name for name in ARCHITECTURES if network_class(name).takes_hidden]
+        raise UsageError(f"--hidden is the {' and '.join(takers)} network's; --architecture {args.architecture}"
+                         " has its own layers")
     return ()
-
-
-def _network_options(args) -> dict:
-    """``TrainConfig.network_options`` from ``--regions`` and ``--region-method`` (local-parts only)."""
-    opts = {k: v for k, v in (("n_regions", args.regions), ("method", args.region_method)) if v is not None}
-    if opts and args.architecture != "local-parts":
-        raise UsageError(f"--regions and --region-method are the local-parts network's, not {args.architecture}'s")
-    if args.regions is not None:
-        check_at_least(args.regions, 1, "--regions")
-    if args.architecture == "local-parts":
-        latent, regions = args.latent or LOCAL_PARTS_LATENT, args.regions or LOCAL_PARTS_REGIONS
-        if latent % regions:
-            raise UsageError(f"--latent {latent} is not a multiple of --regions {regions} (each region gets as many dimensions)")
-    return opts
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
+    p.__class__ = _TrainParser     # the networks' flags on first parse: they import torch
     p.add_argument("data", metavar="DATA", help="collection: .npz file or folder of meshes")
     add_output_argument(p, "MODEL.pt", "checkpoint file to write")
     p.add_argument("--features", choices=FEATURE_KINDS, default=None,
                    help="what the network sees: RIMD features (the paper), or the baselines of Table 2:"
-                   f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND}; for the"
-                   " spiral network, coords)")
-    p.add_argument("--architecture", choices=ARCHITECTURE_NAMES, default=DEFAULT_ARCHITECTURE,
-                   help=f"the network: the paper's fully connected mesh VAE ({DEFAULT_ARCHITECTURE}, default) or a"
-                        f" spiral-convolution network on vertex positions (spiral: SpiralNet++'s settings, latent {SPIRAL_LATENT},"
-                        f" {SPIRAL_EPOCHS} epochs, L1 loss) or a decoder of local parts (local-parts: --regions regions of"
-                        f" the mesh, latent {LOCAL_PARTS_LATENT} shared among them, each region's PCA)")
-    p.add_argument("--regions", type=int, default=None, metavar="R",
-                   help=f"local-parts: regions of the mesh (default {LOCAL_PARTS_REGIONS}; the latent size must be a multiple)")
-    p.add_argument("--region-method", choices=REGION_METHODS, default=None,
-                   help=f"local-parts: how regions are found (default {LOCAL_PARTS_METHOD}; spectral: k-means on the"
-                        " mesh graph Laplacian's eigenvectors, regions that follow the surface; kmeans: on the vertex positions)")
+                   f" rigidly aligned or raw vertex coordinates (default: {DEFAULT_FEATURE_KIND}, or the first"
+                   " kind a network that reads only some can read)")
     p.add_argument("--latent", type=int, default=None, metavar="D",
-                   help=f"latent size (default {DEFAULT_LATENT}, or with the PCA start one per direction the training"
-                        f" meshes span when that is more, up to {PCA_LATENT_MAX})")
+                   help=f"latent size (default: the network's; the mesh VAE's {DEFAULT_LATENT}, or with the PCA start"
+                        f" one per direction the training meshes span when that is more, up to {PCA_LATENT_MAX})")
     p.add_argument("--epochs", type=int, default=None, metavar="E",
-                   help=f"training epochs, the most early stopping may choose (default {DEFAULT_EPOCHS}; spiral: {SPIRAL_EPOCHS})")
+                   help=f"training epochs, the most early stopping may choose (default: the network's, {DEFAULT_EPOCHS} for the mesh VAE)")
     p.add_argument("--init", choices=INIT_MODES, default=DEFAULT_INIT,
                    help="pca (default): start from the PCA of the training features (networks without internal"
                         " layers, standard prior, no labels; docs/vae.md); random: PyTorch's initialisation (the paper)")
@@ -196,11 +237,11 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import read_collection
     from meshvae_lib.model.train_config import TrainConfig
 
+    from meshvae_lib.model.networks import network_class
+
     # every value is checked before the data is read and any training starts
     if args.latent is not None:
         check_at_least(args.latent, 1, "--latent")
-    if args.sigma_object is not None and len(args.sigma_object) > (args.latent or DEFAULT_LATENT):
-        raise UsageError(f"--sigma-object has {len(args.sigma_object)} values, more than --latent {args.latent or DEFAULT_LATENT}")
     if args.epochs is not None:
         check_at_least(args.epochs, 1, "--epochs")
         check_at_most(args.epochs, MAX_EPOCHS, "--epochs")
@@ -214,8 +255,9 @@ def run(args) -> int:
     check_at_least(args.seed, 0, "--seed")
     _check_device(args.device)
     check_output(args.output, parents=True)  # model.save creates missing folders
-    hidden = _network_choices(args)
-    options = _network_options(args)
+    network = network_class(args.architecture)
+    hidden = _network_choices(args, network)
+    options, flags = _network_options(args, network)
     try:
         config = TrainConfig(architecture=args.architecture, network_options=options, epochs=args.epochs, batch_size=args.batch_size, lr=args.lr, alpha=args.alpha,
                              latent_dim=args.latent, hidden=hidden, sigma_object=args.sigma_object,
@@ -223,15 +265,15 @@ def run(args) -> int:
                              early_stopping=False if args.no_early_stopping else None,
                              device=args.device, progress=not args.no_progress)
     except ValueError as exc:
-        raise UsageError(_option_names(str(exc))) from None
+        raise UsageError(_option_names(str(exc), flags)) from None
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     if not -len(collection) <= args.reference < len(collection):
         raise UsageError(f"--reference {args.reference} is out of range for {len(collection)} meshes"
                          f" (0..{len(collection) - 1})")
     n_features = (3 * collection.n_vertices if args.features != "rimd"
                   else 6 * collection.n_vertices + 9 * len(collection.faces))  # RIMD: 6V + 6E, E <= 3F/2
-    n_params = _network_parameters(n_features, hidden, args.latent or PCA_LATENT_MAX)
-    if args.architecture == DEFAULT_ARCHITECTURE and n_params > MAX_NETWORK_PARAMETERS:
+    n_params = network.weights_estimate(n_features, config)
+    if n_params is not None and n_params > MAX_NETWORK_PARAMETERS:
         raise UsageError(f"the network would have about {n_params:,} weights (K = {n_features:,} features,"
                          f" --hidden {' '.join(map(str, hidden)) or '(none)'}, --latent {args.latent or 'auto'});"
                          f" the limit is {MAX_NETWORK_PARAMETERS:,}: choose smaller --hidden or --latent")
@@ -245,7 +287,7 @@ def run(args) -> int:
     except TrainingDiverged as exc:  # valid input, failed training: not the command's fault
         raise CommandFailed(str(exc)) from exc
     except ValueError as exc:
-        raise UsageError(_option_names(str(exc))) from exc
+        raise UsageError(_option_names(str(exc), flags)) from exc
     model.save(args.output)
     last = model.history_[-1]
     if model.selection_ is not None and "skipped" in model.selection_:

@@ -237,7 +237,7 @@ def describe_model(model) -> dict:
     net = model.network
     return {
         "architecture": str(config.architecture),
-        "network": net.describe() if callable(getattr(net, "describe", None)) else type(net).__name__,
+        "network": net.describe(),
         "features": str(model.features),
         "n_features": int(model.n_features),
         "latent_dim": int(model.latent_dim),

@@ -2,7 +2,7 @@
 (notebook 07, Sec. 4.4).
 
 :func:`prior_cost_figure` draws two panels, each computed with
-:func:`meshvae_lib.model.vae.kl_divergence` for a single latent dimension:
+:func:`meshvae_lib.model.loss.kl_divergence` for a single latent dimension:
 
 - left, the price of moving a posterior mean ``mu`` (its width at its cheapest, ``sigma = s``):
   the exact KL with ``s`` small is a parabola ``1/s^2`` times steeper than the sibling formula's,
@@ -27,7 +27,7 @@ def one_dimension_cost(mu, sigma, s: float, form: str = "exact") -> np.ndarray:
     """
     import torch
 
-    from meshvae_lib.model.vae import kl_divergence
+    from meshvae_lib.model.loss import kl_divergence
 
     mu, sigma = np.broadcast_arrays(np.asarray(mu, dtype=np.float64), np.asarray(sigma, dtype=np.float64))
     cost = kl_divergence(torch.from_numpy(mu.reshape(-1, 1).copy()), torch.from_numpy(sigma.reshape(-1, 1).copy()),

@@ -15,23 +15,53 @@ its PCA.
 
 It is a :class:`~meshvae_lib.model.vae.MeshVAE` without internal layers whose decoder weight is
 zero outside the blocks (region's features x region's dimensions): every inference, the
-Gauss-Newton fast path included, works on it unchanged. Training keeps the blocks (the weight's
+mesh VAE's closed-form linearisation included, works on it unchanged. Training keeps the blocks (the weight's
 gradient is masked to them), and is skipped by default: each region's start is the PCA of its
 features, the optimum of a linear autoencoder of that region (``linear_optimum``).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 import torch
 
 from torch import nn
 
-from meshvae_lib.defaults import DEFAULT_EPOCHS, LOCAL_PARTS_LATENT, LOCAL_PARTS_METHOD, LOCAL_PARTS_REGIONS, SIGMA_MAX
+from meshvae_lib.defaults import LOCAL_PARTS_LATENT, LOCAL_PARTS_METHOD, LOCAL_PARTS_REGIONS, REGION_METHODS, SIGMA_MAX
+from meshvae_lib.model.network_base import TRAIN_DEFAULTS
 from meshvae_lib.model.pca_start import regional_pca_start, write_start
 from meshvae_lib.model.vae import MeshVAE
 
-__all__ = ["LocalPartsVAE"]
+__all__ = ["LocalPartsVAE", "LocalPartsOptions", "check_regions"]
+
+
+def check_regions(latent_dim: int, n_regions: int) -> None:
+    """ValueError unless the latent size ``latent_dim`` splits into ``n_regions`` (>= 1) regions of
+    as many dimensions each."""
+    if int(n_regions) < 1 or int(latent_dim) % int(n_regions):
+        raise ValueError(f"latent_dim {latent_dim} is not a multiple of n_regions {n_regions}"
+                         " (each region gets as many dimensions)")
+
+
+@dataclass(frozen=True)
+class LocalPartsOptions:
+    """The decoder of local parts' options (``TrainConfig.network_options``; ``meshvae train`` flags)."""
+
+    n_regions: int = field(default=LOCAL_PARTS_REGIONS, metadata={
+        "flag": "--regions", "metavar": "R",
+        "help": "regions of the mesh (the latent size must be a multiple)"})
+    method: str = field(default=LOCAL_PARTS_METHOD, metadata={
+        "flag": "--region-method", "choices": REGION_METHODS,
+        "help": "how regions are found (spectral: k-means on the mesh graph Laplacian's eigenvectors, regions"
+                " that follow the surface; kmeans: on the vertex positions)"})
+
+    def __post_init__(self):
+        if int(self.n_regions) < 1:
+            raise ValueError(f"n_regions must be at least 1, got {self.n_regions}")
+        if self.method not in REGION_METHODS:
+            raise ValueError(f"method must be one of {REGION_METHODS}, got {self.method!r}")
 
 
 class LocalPartsVAE(MeshVAE):
@@ -50,9 +80,12 @@ class LocalPartsVAE(MeshVAE):
     """
 
     architecture = "local-parts"
+    description = f"a decoder of local parts (regions of the mesh, latent {LOCAL_PARTS_LATENT} shared among them, each region's PCA)"
     outputs = ("tanh",)
-    options = {"n_regions": LOCAL_PARTS_REGIONS, "method": LOCAL_PARTS_METHOD}
-    train_defaults = {"epochs": DEFAULT_EPOCHS, "output": "tanh", "loss": "mse", "latent_dim": LOCAL_PARTS_LATENT}
+    Options = LocalPartsOptions
+    train_defaults = {**TRAIN_DEFAULTS, "latent_dim": LOCAL_PARTS_LATENT}
+    conditional = False
+    takes_hidden = False
     pca_start = True
     #: why its start is kept untrained by default (:func:`~meshvae_lib.model.training.start_is_optimum`).
     linear_optimum = ("each region's decoder starts at the PCA of the region's own features, the optimum of a"
@@ -61,8 +94,7 @@ class LocalPartsVAE(MeshVAE):
     def __init__(self, n_features: int, latent_dim: int = LOCAL_PARTS_LATENT, n_vertices: int = 1,
                  n_regions: int = LOCAL_PARTS_REGIONS, n_conditions: int = 0, sigma_max: float = SIGMA_MAX,
                  sigma_floor: float = 0.0):
-        if int(n_regions) < 1 or int(latent_dim) % int(n_regions):
-            raise ValueError(f"latent_dim must be a multiple of n_regions, got {latent_dim} and {n_regions}")
+        check_regions(latent_dim, n_regions)
         if n_conditions:
             raise ValueError("the local-parts network is unconditional (no labels)")
         super().__init__(n_features, latent_dim, (), 0, sigma_max, input_rank=int(latent_dim), sigma_floor=sigma_floor)
@@ -98,13 +130,12 @@ class LocalPartsVAE(MeshVAE):
         if config.hidden or config.output != "tanh" or n_conditions:
             raise ValueError(f"the local-parts network has no internal layers, a tanh output and no labels;"
                              f" got hidden={config.hidden}, output={config.output!r}, {n_conditions} conditions")
-        opts = {**cls.options, **dict(config.network_options)}
-        R, D = int(opts["n_regions"]), int(config.latent_dim)
-        if R < 1 or D % R:
-            raise ValueError(f"the latent size must be a multiple of n_regions, got {D} and {R}")
+        opts = cls.options(config)
+        R, D = int(opts.n_regions), int(config.latent_dim)
+        check_regions(D, R)
         if x.shape[1] != len(mesh.feature_vertex):
             raise ValueError(f"rows have {x.shape[1]} numbers; the feature kind has {len(mesh.feature_vertex)}")
-        vertex_region = mesh_regions(mesh.vertices, mesh.faces, R, opts["method"])
+        vertex_region = mesh_regions(mesh.vertices, mesh.faces, R, opts.method)
         feature_region = vertex_region[np.asarray(mesh.feature_vertex)]
         start, latent_region = regional_pca_start(x.detach().double().cpu().numpy(), feature_region, R, D // R,
                                                   config.alpha)
@@ -115,6 +146,17 @@ class LocalPartsVAE(MeshVAE):
             net.feature_region.copy_(torch.from_numpy(feature_region))
             net.latent_region.copy_(torch.from_numpy(latent_region))
         return net
+
+    @classmethod
+    def check_config(cls, config) -> None:
+        """The latent size (``config.nominal_latent_dim()``: the architecture's default when unset)
+        must split into the regions."""
+        check_regions(config.nominal_latent_dim(), cls.options(config).n_regions)
+
+    @classmethod
+    def weights_estimate(cls, n_features: int, config) -> None:
+        """None: the network has as many weights as the latent size allows (no internal layers)."""
+        return None
 
     def describe(self) -> str:
         """The network in a few words (for summaries)."""

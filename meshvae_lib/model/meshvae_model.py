@@ -70,8 +70,9 @@ class MeshVAEModel:
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
-    train_config_ : TrainConfig the network was trained with (``config`` or the defaults, its latent
-        size resolved; ``config`` itself is left as given).
+    train_config_ : TrainConfig the network was trained with (``config`` or the defaults, resolved
+        once by :meth:`~meshvae_lib.model.train_config.TrainConfig.resolve`: latent size, ``a``,
+        ``feature_scale``; written into the checkpoint; ``config`` itself is left as given).
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`).
     train_seconds_ : float.
     train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
@@ -113,8 +114,8 @@ class MeshVAEModel:
         kind = make_kind(self.features, V[self.reference_index], collection.faces, layout=self.layout)
         X = kind.encode(V)
         n_cond = len(self.labels)
-        normalizer = FeatureNormalizer(a=config.resolved_a(n_cond),
-                                       scale=config.resolved_feature_scale(self.features, n_cond)).fit(X[~mask])
+        config = config.resolve(int((~mask).sum()), n_cond, self.features)   # once: the checkpoint records it
+        normalizer = FeatureNormalizer(a=config.a, scale=config.feature_scale).fit(X[~mask])
         Xn = normalizer.transform(X)
         conditions = ConditionEncoder(self.labels).fit({c: np.asarray(labels[c])[~mask] for c in self.labels})
         C = conditions.transform(labels) if self.labels else None
@@ -130,7 +131,7 @@ class MeshVAEModel:
         self.holdout_mask_ = mask
         self.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
         self.sigma_object_ = so if so is not None and config.prior_form == "exact" else np.ones(D)
-        self.train_config_ = TrainConfig(**{**config.to_dict(), "latent_dim": D})
+        self.train_config_ = config
         return self
 
     # -- what it is ----------------------------------------------------------------------------
@@ -251,8 +252,8 @@ class MeshVAEModel:
         options = {} if iterations is None else {"iterations": iterations}
         strategy = make_inference(self.inference if inference is None else inference, **options)
         Z = strategy.infer(self, V, C, **({"progress": True} if progress else {}))
-        if hasattr(strategy, "report_"):
-            self.last_inference_ = strategy.report_
+        if strategy.report() is not None:
+            self.last_inference_ = strategy.report()
         return (Z, self.encode_rows(self.features_of(V), C)[1]) if return_sigma else Z
 
     @torch.no_grad()
@@ -375,7 +376,7 @@ class MeshVAEModel:
         net = self.network_
         arch = "" if net.architecture == DEFAULT_ARCHITECTURE else f", architecture={net.architecture!r}"
         return (f"MeshVAEModel(features={self.kind_.name!r}, n_vertices={self.kind_.n_vertices},"
-                f" K={net.n_features}, latent={net.latent_dim}, hidden={list(net.config().get('hidden', []))}"
+                f" K={net.n_features}, latent={net.latent_dim}, hidden={list(self.train_config_.hidden)}"
                 f"{arch}, conditions={self.conditions_.columns})")
 
 

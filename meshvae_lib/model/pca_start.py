@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvae_lib.model.posterior import linear_gaussian_sigma
 from meshvae_lib.tolerances import PCA_INIT_RTOL
 
 __all__ = ["PCAStart", "pca_start", "regional_pca_start", "write_start"]
@@ -69,7 +70,7 @@ def pca_start(X: np.ndarray, latent_dim: int, alpha: float) -> PCAStart:
     Z = Xc @ V.T / c  # (N, r) whitened coefficients
     A = np.arctanh(np.clip(X, -1 + 1e-6, 1 - 1e-6))
     sol, *_ = np.linalg.lstsq(np.c_[Z, np.ones(n)], A, rcond=None)  # (r + 1, K)
-    sigma = 1.0 / np.sqrt(1.0 + alpha * c ** 2 / k)
+    sigma = linear_gaussian_sigma(c, alpha, k)
     return PCAStart(mean=mean, basis=V / c[:, None], sigma=sigma, decoder_weight=sol[:r].T, decoder_bias=sol[r])
 
 
@@ -105,7 +106,7 @@ def regional_pca_start(X: np.ndarray, feature_region: np.ndarray, n_regions: int
         dims = g * per_region + np.arange(part.rank)
         start.basis[np.ix_(dims, cols)] = part.basis
         c = 1.0 / np.linalg.norm(part.basis, axis=1)  # basis row = v / c with |v| = 1
-        start.sigma[dims] = 1.0 / np.sqrt(1.0 + alpha * c ** 2 / k)
+        start.sigma[dims] = linear_gaussian_sigma(c, alpha, k)
         start.decoder_weight[np.ix_(cols, dims)] = part.decoder_weight
         start.decoder_bias[cols] = part.decoder_bias
     return start, np.repeat(np.arange(n_regions, dtype=np.int64), per_region)
@@ -118,8 +119,10 @@ def write_start(net, start: PCAStart) -> None:
     beyond the start's rank), the decoder's weight and bias; condition inputs get zero weights."""
     import torch
 
+    from meshvae_lib.model.network_base import deviation_logit
+
     r, D = start.rank, net.latent_dim
-    sigma_logit = np.log(start.sigma / (net.sigma_max - start.sigma))
+    sigma_logit = deviation_logit(start.sigma, net.sigma_max)
     f32 = lambda a: torch.as_tensor(np.ascontiguousarray(a), dtype=torch.float32)  # noqa: E731
     with torch.no_grad():
         net.input_mean.copy_(f32(start.mean))
@@ -127,7 +130,7 @@ def write_start(net, start: PCAStart) -> None:
         net.encoder_head.weight.zero_()
         net.encoder_head.bias.zero_()
         net.encoder_head.weight[:r, :r] = torch.eye(r)
-        net.encoder_head.bias[D:] = float(np.log(1.0 / (net.sigma_max - 1.0)))  # sigma = 1
+        net.encoder_head.bias[D:] = float(deviation_logit(1.0, net.sigma_max))  # sigma = 1
         net.encoder_head.bias[D:D + r] = f32(sigma_logit)
         net.decoder_head.weight.zero_()
         net.decoder_head.weight[:, :r] = f32(start.decoder_weight)

@@ -17,18 +17,38 @@ epoch). It works on feature kinds whose rows are positions (``defaults.POSITION_
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 import torch
 from torch import nn
 
 from meshvae_lib.defaults import (POSITION_KINDS, SIGMA_MAX, SPIRAL_CHANNELS, SPIRAL_DOWNSAMPLING,
                                   SPIRAL_EPOCHS, SPIRAL_LATENT, SPIRAL_LENGTH)
-from meshvae_lib.tolerances import SIGMA_LOGIT_MIN
+from meshvae_lib.model.network_base import Network
 
-__all__ = ["SpiralVAE"]
+__all__ = ["SpiralVAE", "SpiralOptions"]
 
 
-class SpiralVAE(nn.Module):
+@dataclass(frozen=True)
+class SpiralOptions:
+    """The spiral network's options (``TrainConfig.network_options``; ``meshvae train`` flags)."""
+
+    channels: tuple[int, ...] = field(default=tuple(SPIRAL_CHANNELS), metadata={
+        "help": "the spiral convolutions' widths, finest level first"})
+    spiral_length: int = field(default=SPIRAL_LENGTH, metadata={"help": "the length of every spiral"})
+    factors: tuple[int, ...] = field(default=tuple(SPIRAL_DOWNSAMPLING), metadata={
+        "help": "the down-sampling factor of each level (one per channel width)"})
+
+    def __post_init__(self):
+        object.__setattr__(self, "channels", tuple(int(c) for c in self.channels))
+        object.__setattr__(self, "factors", tuple(int(f) for f in self.factors))
+        if min(self.channels, default=0) < 1 or int(self.spiral_length) < 1 or min(self.factors, default=0) < 1:
+            raise ValueError(f"channels, spiral_length and factors must be positive, got {list(self.channels)},"
+                             f" {self.spiral_length}, {list(self.factors)}")
+
+
+class SpiralVAE(Network):
     """Spiral-convolution VAE on rows of ``3 n`` normalised vertex coordinates (x0, y0, z0, x1, ...).
 
     Parameters
@@ -46,10 +66,12 @@ class SpiralVAE(nn.Module):
     """
 
     architecture = "spiral"
+    description = (f"a spiral-convolution network on vertex positions (SpiralNet++'s settings, latent {SPIRAL_LATENT},"
+                   f" {SPIRAL_EPOCHS} epochs, L1 loss)")
     n_conditions = 0
     output = "linear"
     #: the options ``TrainConfig`` takes for this architecture (``network_options``).
-    options = {"channels": SPIRAL_CHANNELS, "spiral_length": SPIRAL_LENGTH, "factors": SPIRAL_DOWNSAMPLING}
+    Options = SpiralOptions
     #: what ``TrainConfig`` leaves unset means for this architecture (the authors' settings).
     train_defaults = {"epochs": SPIRAL_EPOCHS, "output": "linear", "loss": "l1", "latent_dim": SPIRAL_LATENT}
     outputs = ("linear",)
@@ -101,10 +123,6 @@ class SpiralVAE(nn.Module):
                 "sigma_max": self.sigma_max, "sigma_floor": self.sigma_floor}
 
     @classmethod
-    def from_config(cls, config: dict) -> "SpiralVAE":
-        return cls(**config)
-
-    @classmethod
     def start(cls, x: torch.Tensor, n_conditions: int, config, mesh) -> "SpiralVAE":
         """A new network (Xavier-uniform weights, seeded by the caller) for rows ``x (N, 3 n)`` of
         ``mesh`` (a :class:`~meshvae_lib.model.networks.ReferenceMesh` whose kind's rows are
@@ -120,23 +138,23 @@ class SpiralVAE(nn.Module):
         if config.hidden:
             raise ValueError(f"the spiral network has no 'hidden' layers (its widths are network_options"
                              f" 'channels'), got hidden={config.hidden}")
-        opts = {**cls.options, **dict(config.network_options)}
+        opts = cls.options(config)
         if x.shape[1] != 3 * len(mesh.vertices):
             raise ValueError(f"rows have {x.shape[1]} numbers; the mesh has {len(mesh.vertices)} vertices")
-        levels = mesh_hierarchy(mesh.vertices, mesh.faces, opts["factors"], opts["spiral_length"])
-        if len(levels) - 1 != len(opts["channels"]):
-            raise ValueError(f"{len(opts['channels'])} channel widths need as many down-sampling factors,"
-                             f" got factors {list(opts['factors'])}")
-        net = cls(config.latent_dim, opts["channels"], opts["spiral_length"], [len(lv.vertices) for lv in levels],
+        levels = mesh_hierarchy(mesh.vertices, mesh.faces, list(opts.factors), opts.spiral_length)
+        if len(levels) - 1 != len(opts.channels):
+            raise ValueError(f"{len(opts.channels)} channel widths need as many down-sampling factors,"
+                             f" got factors {list(opts.factors)}")
+        net = cls(config.latent_dim, list(opts.channels), opts.spiral_length, [len(lv.vertices) for lv in levels],
                   [lv.down.nnz for lv in levels[:-1]], [lv.up.nnz for lv in levels[:-1]],
                   sigma_floor=config.sigma_floor)
         with torch.no_grad():
             for level, lv in enumerate(levels[:-1]):  # the coarsest level has no convolution
-                getattr(net, f"spirals_{level}").copy_(torch.from_numpy(lv.spirals))
+                net.get_buffer(f"spirals_{level}").copy_(torch.from_numpy(lv.spirals))
                 for name, m in (("down", lv.down), ("up", lv.up)):
                     m = m.tocoo()
-                    getattr(net, f"{name}_{level}_index").copy_(torch.from_numpy(np.stack([m.row, m.col]).astype(np.int64)))
-                    getattr(net, f"{name}_{level}_value").copy_(torch.from_numpy(m.data.astype(np.float32)))
+                    net.get_buffer(f"{name}_{level}_index").copy_(torch.from_numpy(np.stack([m.row, m.col]).astype(np.int64)))
+                    net.get_buffer(f"{name}_{level}_value").copy_(torch.from_numpy(m.data.astype(np.float32)))
         return net
 
     def describe(self) -> str:
@@ -144,55 +162,33 @@ class SpiralVAE(nn.Module):
         return (f"spiral convolutions {' -> '.join(map(str, self.channels))} (spirals of {self.spiral_length}) on"
                 f" {' -> '.join(map(str, self.level_sizes))} vertices, a linear output")
 
-    def used_latent_dims(self) -> np.ndarray:
-        """Every latent dimension (a nonlinear decoder reads them all)."""
-        return np.arange(self.latent_dim)
-
     # -- the layers ----------------------------------------------------------------------------
     def _conv(self, layer: nn.Linear, h: torch.Tensor, level: int) -> torch.Tensor:
         """Spiral convolution: (B, n_l, C) -> (B, n_l, C')."""
-        s = getattr(self, f"spirals_{level}")
+        s = self.get_buffer(f"spirals_{level}")
         return layer(h.index_select(1, s.reshape(-1)).reshape(h.shape[0], s.shape[0], -1))
 
     def _pool(self, h: torch.Tensor, level: int, way: str) -> torch.Tensor:
         """Sparse sampling ``(B, n_in, C) -> (B, n_out, C)`` with level ``level``'s ``way`` matrix."""
-        index, value = getattr(self, f"{way}_{level}_index"), getattr(self, f"{way}_{level}_value")
+        index, value = self.get_buffer(f"{way}_{level}_index"), self.get_buffer(f"{way}_{level}_value")
         n_out = self.level_sizes[level + 1] if way == "down" else self.level_sizes[level]
         src = h.index_select(1, index[1]) * value[None, :, None].to(h.dtype)
         return torch.zeros(h.shape[0], n_out, h.shape[2], dtype=h.dtype, device=h.device).index_add(1, index[0], src)
 
-    def _check(self, x: torch.Tensor, width: int, what: str, c) -> None:
-        if x.ndim != 2 or x.shape[1] != width:
-            raise ValueError(f"{what} must have shape (batch, {width}), got {tuple(x.shape)}")
-        if c is not None and c.numel() > 0:
-            raise ValueError("this network is unconditional; got a condition tensor")
-
     # -- the four steps ------------------------------------------------------------------------
     def encode(self, x: torch.Tensor, c: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """x (B, 3n) float32 -> mu (B, D), sigma (B, D) (sigma as the mesh VAE's)."""
-        self._check(x, self.n_features, "features", c)
+        self.with_condition(x, c, self.n_features, "features")
         h = x.reshape(x.shape[0], self.n_vertices, 3)
         for level, conv in enumerate(self.encoder_convs):
             h = self._pool(nn.functional.elu(self._conv(conv, h, level)), level, "down")
         out = self.encoder_head(h.reshape(h.shape[0], -1))
-        mu, s = out[:, : self.latent_dim], out[:, self.latent_dim:]
-        sigma = self.sigma_max * torch.sigmoid(s.clamp(min=SIGMA_LOGIT_MIN))
-        return mu, (sigma + self.sigma_floor) if self.sigma_floor else sigma
-
-    def reparameterize(self, mu, sigma, generator: torch.Generator | None = None) -> torch.Tensor:
-        """z = mu + sigma * eps, eps ~ N(0, I) drawn from ``generator``."""
-        return mu + sigma * torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
+        return out[:, : self.latent_dim], self.deviation(out[:, self.latent_dim:])
 
     def decode(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
         """z (B, D) -> rows (B, 3n), unbounded (a linear output)."""
-        self._check(z, self.latent_dim, "latent vectors", c)
+        self.with_condition(z, c, self.latent_dim, "latent vectors")
         h = self.decoder_head(z).reshape(z.shape[0], self.level_sizes[-1], self.channels[-1])
         for level in reversed(range(len(self.channels))):
             h = nn.functional.elu(self._conv(self.decoder_convs[level], self._pool(h, level, "up"), level))
         return self._conv(self.output_conv, h, 0).reshape(z.shape[0], self.n_features)
-
-    def forward(self, x, c=None, generator=None):
-        """(decode(reparameterize(encode(x))), mu, sigma)."""
-        mu, sigma = self.encode(x, c)
-        return self.decode(self.reparameterize(mu, sigma, generator), c), mu, sigma
-

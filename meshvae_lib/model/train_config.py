@@ -4,16 +4,16 @@ the default network size per feature kind and the prior deviations sigma_object 
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields, replace
 
 import numpy as np
 
 from meshvae_lib.defaults import (DEFAULT_ALPHA, DEFAULT_ARCHITECTURE, DEFAULT_BATCH_SIZE,
                                   DEFAULT_FEATURE_KIND, DEFAULT_INIT, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX,
-                                  EARLY_STOPPING_PATIENCE, INIT_MODES, LOSSES, NORMALIZE_A, OUTPUTS,
+                                  EARLY_STOPPING_PATIENCE, INIT_MODES, LOSSES, NORMALIZE_A,
                                   PCA_NORMALIZE_A, PRIOR_FORMS, VALIDATION_EVERY)
 from meshvae_lib.model.feature_kinds import kind_class
-from meshvae_lib.model.networks import ARCHITECTURES, network_class, train_defaults
+from meshvae_lib.model.networks import ARCHITECTURES, network_class
 from meshvae_lib.validation import check_choice
 
 __all__ = ["TrainConfig", "default_hidden", "pad_sigma_object"]
@@ -67,7 +67,7 @@ class TrainConfig:
         padded with 1 by :func:`pad_sigma_object`.
     prior_form : how sigma_object enters the latent cost, "exact" (the KL to N(0, diag
         sigma_object^2)) or "sibling" (the authors' sibling-code formula, which makes the chosen
-        dimensions carry the dominant variation; see :func:`~meshvae_lib.model.vae.kl_divergence`).
+        dimensions carry the dominant variation; see :func:`~meshvae_lib.model.loss.kl_divergence`).
     seed : seeds initial weights, shuffling and sampling.
     device : "auto" (a GPU when there is one, else the CPU), "cpu", "cuda", ...
     progress : show a tqdm progress bar (terminal or notebook).
@@ -112,7 +112,7 @@ class TrainConfig:
         ``BCE_TARGET_RANGE`` (:func:`to_output_range`) and is never PCA-initialised.
     loss : the reconstruction term, "mse" (Eq. 4, the mesh VAE's default), "bce" (binary
         cross-entropy, needs ``output="sigmoid"``) or "l1" (the spiral network's default; see
-        :func:`~meshvae_lib.model.vae.vae_loss`).
+        :func:`~meshvae_lib.model.loss.vae_loss`).
     """
 
     epochs: int | None = None
@@ -145,16 +145,21 @@ class TrainConfig:
         """True when a new network starts at the PCA of its rows (:meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`;
         see ``init``)."""
         return (self.init == "pca" and not self.hidden and self.sigma_object is None and n_conditions == 0
-                and self.output == "tanh" and bool(getattr(network_class(self.architecture), "pca_start", False)))
+                and self.output == "tanh" and network_class(self.architecture).pca_start)
 
     def resolved_latent_dim(self, n_rows: int, n_conditions: int = 0) -> int:
         """D for a new network trained on ``n_rows`` rows (see ``latent_dim``)."""
+        if self.latent_dim is None and "latent_dim" not in network_class(self.architecture).train_defaults \
+                and self.uses_pca_init(n_conditions):
+            return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
+        return self.nominal_latent_dim()
+
+    def nominal_latent_dim(self) -> int:
+        """D before the rows are known: ``latent_dim``, or the architecture's default (the PCA start
+        may choose more, :meth:`resolved_latent_dim`)."""
         if self.latent_dim is not None:
             return int(self.latent_dim)
-        own = getattr(network_class(self.architecture), "train_defaults", {}).get("latent_dim")
-        if own is None and self.uses_pca_init(n_conditions):
-            return int(min(max(DEFAULT_LATENT, int(n_rows) - 1), max(PCA_LATENT_MAX, DEFAULT_LATENT)))
-        return int(train_defaults(self.architecture).get("latent_dim", DEFAULT_LATENT))
+        return int(network_class(self.architecture).train_defaults.get("latent_dim", DEFAULT_LATENT))
 
     def resolved_a(self, n_conditions: int = 0) -> float:
         """a of Eq. 3 (see ``a``)."""
@@ -175,19 +180,31 @@ class TrainConfig:
             return bool(self.early_stopping)
         return self.uses_pca_init(n_conditions)
 
+    def resolve(self, n_rows: int, n_conditions: int = 0, kind: str | None = None) -> "TrainConfig":
+        """The configuration a new network on ``n_rows`` training rows with ``n_conditions``
+        condition inputs and the feature kind ``kind`` is trained with: every option left at None
+        that the rows decide resolved, once, by the rules above (``latent_dim``, ``a`` and, given
+        ``kind``, ``feature_scale``). ``early_stopping`` keeps None, "the default"
+        (:meth:`resolved_early_stopping`; True asks for an epoch search the default may skip). The
+        estimator writes the result into its checkpoint."""
+        return replace(self,
+                       latent_dim=self.resolved_latent_dim(n_rows, n_conditions),
+                       a=self.resolved_a(n_conditions),
+                       feature_scale=self.feature_scale if kind is None else self.resolved_feature_scale(kind, n_conditions))
+
     def __post_init__(self):
         if self.architecture not in ARCHITECTURES:
             raise ValueError(f"TrainConfig.architecture must be one of {tuple(ARCHITECTURES)}, got {self.architecture!r}")
-        unset = train_defaults(self.architecture)
-        for name in ("epochs", "output", "loss"):
-            if getattr(self, name) is None:
-                setattr(self, name, unset[name])
-        self.network_options = dict(self.network_options or {})
         net = network_class(self.architecture)
-        known = dict(getattr(net, "options", {}))
+        self.epochs = net.train_defaults["epochs"] if self.epochs is None else self.epochs
+        self.output = net.train_defaults["output"] if self.output is None else self.output
+        self.loss = net.train_defaults["loss"] if self.loss is None else self.loss
+        self.network_options = dict(self.network_options or {})
+        known = [f.name for f in fields(net.Options)]
         if set(self.network_options) - set(known):
             raise ValueError(f"TrainConfig.network_options: the {self.architecture!r} network takes"
                              f" {sorted(known) or 'none'}, got {sorted(self.network_options)}")
+        net.options(self)  # the options' own checks
         self.hidden = tuple(int(h) for h in self.hidden)
         if self.sigma_object is not None:
             self.sigma_object = tuple(float(s) for s in self.sigma_object)
@@ -206,12 +223,16 @@ class TrainConfig:
             "patience": self.patience >= 1,
             "feature_scale": self.feature_scale in (None, "component", "shared"),
             "sigma_floor": 0.0 <= float(self.sigma_floor) < float("inf"),
-            "output": self.output in getattr(net, "outputs", OUTPUTS),
+            "output": self.output in net.outputs,
             "loss": self.loss in LOSSES and (self.loss != "bce" or self.output == "sigmoid"),
         }
         for name, ok in checks.items():
             if not ok:
-                raise ValueError(f"TrainConfig.{name} is out of range: {getattr(self, name)!r}")
+                raise ValueError(f"TrainConfig.{name} is out of range: {asdict(self)[name]!r}")
+        if self.sigma_object is not None and len(self.sigma_object) > self.nominal_latent_dim():
+            raise ValueError(f"TrainConfig.sigma_object has {len(self.sigma_object)} values, more than latent_dim"
+                             f" {self.nominal_latent_dim()}")
+        net.check_config(self)
 
     def to_dict(self) -> dict:
         d = asdict(self)

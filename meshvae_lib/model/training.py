@@ -25,7 +25,7 @@ from meshvae_lib.defaults import BCE_TARGET_RANGE
 from meshvae_lib.model.inplace_grad import start_step
 from meshvae_lib.model.networks import Network, network_class, start_network
 from meshvae_lib.model.train_config import TrainConfig, pad_sigma_object
-from meshvae_lib.model.vae import vae_loss
+from meshvae_lib.model.loss import vae_loss
 from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.validation import check_count, check_finite, check_rows
 
@@ -273,7 +273,7 @@ def _check_given(model, k: int, n_cond: int, config: TrainConfig) -> None:
             f"the given model expects {model.n_features} features and {model.n_conditions} conditions,"
             f" got {k} and {n_cond}"
         )
-    floor = float(model.config().get("sigma_floor", config.sigma_floor))
+    floor = float(model.sigma_floor)
     if (model.output, floor) != (config.output, float(config.sigma_floor)):
         raise ValueError(f"the given model has output={model.output!r}, sigma_floor={floor:g};"
                          f" the config asks for output={config.output!r}, sigma_floor={config.sigma_floor:g}")
@@ -305,17 +305,18 @@ def start_is_optimum(config: TrainConfig, n_rows: int, n_conditions: int) -> boo
     stopping left to its default (``config.early_stopping is None``; True asks for the search) and a
     latent size (resolved) of at least ``n_rows - 1``, the rank of the centred rows, or a network
     class whose ``linear_optimum`` says why its start is its optimum."""
-    return _skip_reason(config, n_rows, n_conditions) is not None
+    return _skip_reason(config.resolve(n_rows, n_conditions), n_rows, n_conditions) is not None
 
 
 def _skip_reason(config: TrainConfig, n_rows: int, n_conditions: int) -> str | None:
-    """Why a new network's start is kept untrained (see :func:`start_is_optimum`), or None: the
+    """Why a new network's start is kept untrained (see :func:`start_is_optimum`; ``config``
+    resolved), or None: the
     span rule's :data:`START_IS_OPTIMUM`, or the class's own ``linear_optimum`` (the local-parts
     network's, whose every region starts at its own optimum whatever the latent size)."""
     if config.early_stopping is not None or not config.uses_pca_init(n_conditions):
         return None
-    own = getattr(network_class(config.architecture), "linear_optimum", None)
-    if own is None and config.resolved_latent_dim(n_rows, n_conditions) >= n_rows - 1:
+    own = network_class(config.architecture).linear_optimum
+    if own is None and config.latent_dim >= n_rows - 1:
         return START_IS_OPTIMUM
     return own
 
@@ -347,8 +348,9 @@ def train_vae(
     mesh : the :class:`~meshvae_lib.model.networks.ReferenceMesh` the rows come from, for a network
         built on the mesh's connectivity (the spiral network); None where the network needs none.
 
-    The latent size is resolved here and only here (``config.resolved_latent_dim``: the
-    architecture's rule) before the network's ``start``.
+    A config whose latent size is unset is resolved here (:meth:`TrainConfig.resolve`, the one
+    function that resolves a configuration; the estimator has already applied it) before the
+    network's ``start``; continuing ``model``, the latent size is the model's.
 
     Returns
     -------
@@ -359,15 +361,16 @@ def train_vae(
     x, c, xv, cv = _rows(features, conditions, val_features, val_conditions)
     n, k = x.shape
     n_cond = 0 if c is None else c.shape[1]
-    if config.latent_dim is None:
-        config = replace(config, latent_dim=model.latent_dim if model is not None else config.resolved_latent_dim(n, n_cond))
+    config = config.resolve(n, n_cond)                  # explicit options kept: the estimator's is unchanged
+    if model is not None:
+        config = replace(config, latent_dim=model.latent_dim)
     device = resolve_device(config.device)
     if model is not None:
         _check_given(model, k, n_cond, config)
     early = model is None and config.resolved_early_stopping(n_cond) and n >= 2 * config.validation_every
-    so = pad_sigma_object(config.sigma_object, config.latent_dim if model is None else model.latent_dim)
+    so = pad_sigma_object(config.sigma_object, config.latent_dim)
     loss = _Loss(config, None if so is None else torch.as_tensor(so, dtype=torch.float32, device=device),
-                 config.resolved_a(n_cond))
+                 config.a)
 
     t0 = time.perf_counter()
     epochs, selection = config.epochs, None

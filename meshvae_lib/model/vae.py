@@ -1,4 +1,4 @@
-"""The mesh VAE network, its KL term and its loss (paper Sec. 4.2-4.4, Eqs. 4 and 5).
+"""The mesh VAE network (paper Sec. 4.2-4.3); its loss, Eqs. 4 and 5, is :mod:`~meshvae_lib.model.loss`.
 
 Architecture (Sec. 4.2, "Network structure"): a fully connected encoder and decoder. Every
 *internal* layer is ``Linear -> BatchNorm1d -> LeakyReLU``. The encoder ends in two heads, the mean
@@ -19,18 +19,6 @@ training meshes; a K-wide encoder trained with Adam gives those directions arbit
 
 Conditional mesh VAE (Sec. 4.3, Eq. 5): a condition vector c (one-hot labels or any given vector)
 is concatenated to the encoder's input and to the decoder's input.
-
-Extended model (Sec. 4.4): the prior is N(0, diag(sigma_object^2)); ``kl_divergence`` has the
-exact KL to it and the authors' sibling-code formula (``form="sibling"``).
-
-Loss (Eq. 4), for a batch of M meshes with K features each::
-
-    L = alpha / (2 M K) * sum_j sum_i (f^_i^j - f~_i^j)^2  +  (1/M) sum_j KL(q(z | f~^j) || p(z))
-
-i.e. both terms are *means over the meshes of the batch*: the loss is the batch average of the
-per-mesh quantity ``alpha/(2K) |f^ - f~|^2 + KL_j``, where ``KL_j`` sums over the D latent
-dimensions. The mean is taken the same way for both terms, so the balance set by alpha does not
-depend on the batch size.
 """
 
 from __future__ import annotations
@@ -41,19 +29,21 @@ import numpy as np
 import torch
 from torch import nn
 
-from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_EPOCHS, DEFAULT_LATENT, LEAKY_RELU_SLOPE, LOSSES, PRIOR_FORMS, SIGMA_MAX
+from meshvae_lib.defaults import DEFAULT_LATENT, LEAKY_RELU_SLOPE, SIGMA_MAX
 from meshvae_lib.model.inplace_grad import Linear
+from meshvae_lib.model.linearization import DecoderLinearization
+from meshvae_lib.model.network_base import Network
 from meshvae_lib.model.pca_start import pca_start, write_start
-from meshvae_lib.tolerances import GN_UNUSED_DIM_RTOL, SIGMA_LOGIT_MIN
+from meshvae_lib.tolerances import GN_UNUSED_DIM_RTOL
 
-__all__ = ["MeshVAE", "kl_divergence", "vae_loss"]
+__all__ = ["MeshVAE"]
 
 
 def _block(n_in: int, n_out: int, slope: float) -> list[nn.Module]:
     return [Linear(n_in, n_out), nn.BatchNorm1d(n_out), nn.LeakyReLU(slope)]
 
 
-class MeshVAE(nn.Module):
+class MeshVAE(Network):
     """Fully connected (conditional) variational autoencoder on normalised mesh features: the
     ``"mesh-vae"`` architecture of :mod:`meshvae_lib.model.networks`.
 
@@ -85,9 +75,11 @@ class MeshVAE(nn.Module):
 
     #: the architecture's name in :data:`meshvae_lib.model.networks.ARCHITECTURES`.
     architecture = "mesh-vae"
-    #: the decoder's last activations it has, and what ``TrainConfig`` leaves unset means for it.
+    description = "the paper's fully connected mesh VAE"
+    #: the decoder's last activations it has (``train_defaults`` are the base class's).
     outputs = ("tanh", "sigmoid")
-    train_defaults = {"epochs": DEFAULT_EPOCHS, "output": "tanh", "loss": "mse"}
+    conditional = True
+    takes_hidden = True
     #: it can start at the PCA of its rows (:meth:`from_pca`; ``TrainConfig.uses_pca_init``).
     pca_start = True
 
@@ -166,20 +158,16 @@ class MeshVAE(nn.Module):
         }
 
     @classmethod
-    def from_config(cls, config: dict) -> "MeshVAE":
-        """The network :meth:`config` describes (untrained weights)."""
-        return cls(**config)
-
-    @classmethod
     def start(cls, x: torch.Tensor, n_conditions: int, config, mesh=None) -> "MeshVAE":
         """A new network to train on rows ``x (N, K)`` float32 with ``config`` (a
         :class:`~meshvae_lib.model.train_config.TrainConfig` whose ``latent_dim`` the trainer has
         resolved): the PCA start (:meth:`from_pca`) when ``config.uses_pca_init(n_conditions)``, else
         PyTorch's random initialisation (seeded by the caller). The mesh is not needed (the rows are
         all it reads)."""
+        config = config.resolve(x.shape[0], n_conditions)   # a no-op on the trainer's resolved config
         if config.uses_pca_init(n_conditions):
             return cls.from_pca(x, config, n_conditions)
-        return cls(x.shape[1], _latent(config, x.shape[0], n_conditions), config.hidden, n_conditions,
+        return cls(x.shape[1], config.latent_dim, config.hidden, n_conditions,
                    sigma_floor=config.sigma_floor, output=config.output)
 
     @classmethod
@@ -197,7 +185,7 @@ class MeshVAE(nn.Module):
             raise ValueError("the PCA initialisation is for networks without internal layers (hidden=())")
         if config.output != "tanh":
             raise ValueError("the PCA initialisation is for a tanh output (it fits the tanh's pre-activations)")
-        D = _latent(config, x.shape[0], n_conditions)
+        D = config.resolve(x.shape[0], n_conditions).latent_dim     # the trainer's, or the rule's for a direct call
         start = pca_start(x.detach().double().cpu().numpy(), D, config.alpha)
         net = cls(x.shape[1], D, (), n_conditions, input_rank=start.rank, sigma_floor=config.sigma_floor)
         write_start(net, start)
@@ -220,7 +208,7 @@ class MeshVAE(nn.Module):
 
     def linear_decoder(self) -> tuple[torch.Tensor, torch.Tensor] | None:
         """``(W (K, D + C), b (K,))`` float32 when the decoder is ``act(W [z, c] + b)`` (no internal
-        layer), else None: the Gauss-Newton inference's fast path."""
+        layer), else None: the blocks a decoder of local parts keeps (notebook 10)."""
         if self.hidden:
             return None
         return self.decoder_head.weight.detach(), self.decoder_head.bias.detach()
@@ -228,29 +216,28 @@ class MeshVAE(nn.Module):
     def decoder_hidden(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
         """The input of the decoder's output layer: the internal layers' output for ``z (B, D)``
         [+ ``c (B, C)``], or ``[z, c]`` itself without internal layers."""
-        return self.decoder_body(self._with_condition(z, c, self.latent_dim, "latent vectors"))
+        return self.decoder_body(self.with_condition(z, c, self.latent_dim, "latent vectors"))
 
-    def decoder_jacobian(self, z: np.ndarray, c: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Decoded rows ``(K,)`` and ``d rows / d z`` ``(K, D)``, float64, in closed form
-        (:func:`~meshvae_lib.model.vae_linearization.mesh_vae_decoder_jacobian`)."""
-        from meshvae_lib.model.vae_linearization import mesh_vae_decoder_jacobian
+    def linearization(self, used: np.ndarray) -> DecoderLinearization:
+        """The decoder linearised in closed form over the latent dimensions ``used``
+        (:mod:`~meshvae_lib.model.vae_linearization`): ``act'(y) W`` without internal layers (the
+        used columns converted once), autograd for the internal layers otherwise."""
+        from meshvae_lib.model.vae_linearization import HiddenLayersLinearization, LinearDecoderLinearization
 
-        return mesh_vae_decoder_jacobian(self, z, c)
+        return (HiddenLayersLinearization if self.hidden else LinearDecoderLinearization)(self, used)
 
-    def _with_condition(self, x: torch.Tensor, c, width: int, what: str) -> torch.Tensor:
-        if x.ndim != 2 or x.shape[1] != width:
-            raise ValueError(f"{what} must have shape (batch, {width}), got {tuple(x.shape)}")
-        if self.n_conditions == 0:
-            if c is not None and c.numel() > 0:
-                raise ValueError("this network is unconditional; got a condition tensor")
-            return x
-        if c is None:
-            raise ValueError(f"this network is conditional: give a condition of shape (batch, {self.n_conditions})")
-        if c.ndim != 2 or c.shape != (x.shape[0], self.n_conditions):
-            raise ValueError(
-                f"condition must have shape ({x.shape[0]}, {self.n_conditions}), got {tuple(c.shape)}"
-            )
-        return torch.cat([x, c.to(x.dtype)], dim=1)
+    @classmethod
+    def weights_estimate(cls, n_features: int, config) -> int:
+        """About how many weights the encoder and the decoder have (K -> hidden -> 2 x latent,
+        latent -> hidden reversed -> K), the latent size ``config.latent_dim`` or, unresolved, the
+        most the PCA start may choose (``PCA_LATENT_MAX``)."""
+        from meshvae_lib.defaults import PCA_LATENT_MAX
+
+        latent = config.latent_dim or PCA_LATENT_MAX
+        sizes = [n_features, *config.hidden]
+        enc = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * 2 * latent
+        dec = sum(a * b for a, b in zip(sizes, sizes[1:])) + sizes[-1] * latent
+        return enc + dec
 
     # -- the four steps ------------------------------------------------------------------------
     def encode(self, x: torch.Tensor, c: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
@@ -265,24 +252,11 @@ class MeshVAE(nn.Module):
             if x.ndim != 2 or x.shape[1] != self.n_features:
                 raise ValueError(f"features must have shape (batch, {self.n_features}), got {tuple(x.shape)}")
             x = (x - self.input_mean) @ self.input_basis.t()
-            h = self.encoder_body(self._with_condition(x, c, self.input_rank, "projected features"))
+            h = self.encoder_body(self.with_condition(x, c, self.input_rank, "projected features"))
         else:
-            h = self.encoder_body(self._with_condition(x, c, self.n_features, "features"))
+            h = self.encoder_body(self.with_condition(x, c, self.n_features, "features"))
         out = self.encoder_head(h)
-        mu, s = out[:, : self.latent_dim], out[:, self.latent_dim :]
-        # With K ~ 1e4-1e5 inputs an Adam step can move s by ~10, and alpha = 1e6 pushes sigma to
-        # 0: without a floor sigmoid underflows, log(sigma^2) = -inf and training turns to NaN.
-        sigma = self.sigma_max * torch.sigmoid(s.clamp(min=SIGMA_LOGIT_MIN))
-        if self.sigma_floor:
-            sigma = sigma + self.sigma_floor
-        return mu, sigma
-
-    def reparameterize(
-        self, mu: torch.Tensor, sigma: torch.Tensor, generator: torch.Generator | None = None
-    ) -> torch.Tensor:
-        """z = mu + sigma * eps, eps ~ N(0, I) drawn from ``generator``. (B, D) -> (B, D)."""
-        eps = torch.randn(mu.shape, generator=generator, dtype=mu.dtype, device=mu.device)
-        return mu + sigma * eps
+        return out[:, : self.latent_dim], self.deviation(out[:, self.latent_dim :])
 
     def decode(self, z: torch.Tensor, c: torch.Tensor | None = None) -> torch.Tensor:
         """Probabilistic decoder's mean: z (B, D) [+ c (B, C)] -> features (B, K) in (-1, 1)
@@ -291,97 +265,3 @@ class MeshVAE(nn.Module):
         if self.output == "sigmoid":
             return torch.sigmoid(self.decoder_head(h))
         return torch.tanh(self.decoder_head(h))
-
-    def forward(
-        self, x: torch.Tensor, c: torch.Tensor | None = None, generator: torch.Generator | None = None
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Encode, sample z, decode. Returns (x_hat (B, K), mu (B, D), sigma (B, D))."""
-        mu, sigma = self.encode(x, c)
-        z = self.reparameterize(mu, sigma, generator)
-        return self.decode(z, c), mu, sigma
-
-
-def _latent(config, n_rows: int, n_conditions: int) -> int:
-    """The latent size of a new network: the one rule,
-    :meth:`~meshvae_lib.model.train_config.TrainConfig.resolved_latent_dim` (the trainer has already
-    applied it; a start called directly applies it here)."""
-    return config.resolved_latent_dim(n_rows, n_conditions)
-
-
-def kl_divergence(
-    mu: torch.Tensor, sigma: torch.Tensor, sigma_object: torch.Tensor | None = None, form: str = "exact"
-) -> torch.Tensor:
-    """The latent cost of Eq. (4) with the extended prior of Sec. 4.4, summed over the dimensions.
-
-    ``form="exact"``: KL( N(mu, diag sigma^2) || N(0, diag sigma_object^2) ), per dimension::
-
-        1/2 [ (sigma^2 + mu^2) / sigma_object^2 - 1 - log(sigma^2 / sigma_object^2) ]
-
-    ``form="sibling"``: the formula of the authors' sibling code, per dimension::
-
-        1/2 [ mu^2 + (sigma / sigma_object)^2 - log((sigma / sigma_object)^2) - 1 ]
-
-    which does not divide mu^2 by sigma_object^2. It is not a KL to a fixed prior: it makes a
-    *narrow* posterior (width about sigma_object) cheap in the chosen dimensions while the means
-    keep the unit spread of N(0, I). The exact form is invariant under ``z_i -> z_i / s_i`` (a
-    linear decoder absorbs the rescaling), so on its own it cannot make a dimension more important;
-    the sibling form can (see ``docs/applications.md``, "Embedding"). With ``sigma_object=None``
-    both forms are the standard KL to N(0, I) (paper Eq. 4).
-
-    mu, sigma : (B, D) float tensors, sigma > 0; sigma_object : (D,) positive or None;
-    form : "exact" or "sibling".
-    Returns (B,) latent cost per sample.
-    """
-    if form not in PRIOR_FORMS:
-        raise ValueError(f"form must be one of {PRIOR_FORMS}, got {form!r}")
-    if mu.shape != sigma.shape:
-        raise ValueError(f"mu and sigma must have the same shape, got {tuple(mu.shape)} and {tuple(sigma.shape)}")
-    var = sigma * sigma
-    if sigma_object is None:
-        return 0.5 * torch.sum(var + mu * mu - 1.0 - torch.log(var), dim=-1)
-    so = torch.as_tensor(sigma_object, dtype=mu.dtype, device=mu.device)
-    if so.shape != mu.shape[-1:]:
-        raise ValueError(f"sigma_object must have shape ({mu.shape[-1]},), got {tuple(so.shape)}")
-    var_o = so * so
-    if form == "sibling":
-        return 0.5 * torch.sum(mu * mu + var / var_o - 1.0 - torch.log(var / var_o), dim=-1)
-    return 0.5 * torch.sum((var + mu * mu) / var_o - 1.0 - torch.log(var / var_o), dim=-1)
-
-
-def vae_loss(
-    x_hat: torch.Tensor,
-    x: torch.Tensor,
-    mu: torch.Tensor,
-    sigma: torch.Tensor,
-    alpha: float = DEFAULT_ALPHA,
-    sigma_object: torch.Tensor | None = None,
-    prior_form: str = "exact",
-    loss: str = "mse",
-) -> dict[str, torch.Tensor]:
-    """Mesh VAE loss (Eq. 4; Eq. 5 for the conditional model, whose prior does not depend on c).
-
-    x_hat, x : (M, K) decoder output and normalised target; mu, sigma : (M, D); sigma_object and
-    prior_form : see :func:`kl_divergence`; loss : the reconstruction term, "mse" (the paper's),
-    "bce" (binary cross-entropy of a sigmoid output against targets in [0, 1] -- others are clipped --,
-    summed over the K components and averaged over the meshes, as DRAW; alpha is not used; Sec. 5.1)
-    or "l1" (SpiralNet++'s: alpha/(MK) sum |x_hat - x|).
-    Returns a dict of scalar tensors: ``reconstruction`` = alpha/(2MK) sum (x_hat - x)^2 (or
-    the cross-entropy, or the L1 term), ``kl`` = (1/M) sum_j KL_j, ``total`` = their sum (the value to minimise),
-    and ``mse`` = mean squared error per component (for logging; alpha-free).
-    """
-    if x_hat.shape != x.shape or x.ndim != 2:
-        raise ValueError(f"x_hat and x must be (M, K) of the same shape, got {tuple(x_hat.shape)} and {tuple(x.shape)}")
-    if loss not in LOSSES:
-        raise ValueError(f"loss must be one of {LOSSES}, got {loss!r}")
-    if loss == "bce":
-        # targets beyond [0, 1] (held-out rows outside the training range) are clipped: BCE needs [0, 1]
-        reconstruction = torch.nn.functional.binary_cross_entropy(x_hat, x.clamp(0.0, 1.0), reduction="sum") / x.shape[0]
-        mse = torch.nn.functional.mse_loss(x_hat.detach(), x)
-    elif loss == "l1":
-        mse = torch.nn.functional.mse_loss(x_hat.detach(), x)
-        reconstruction = alpha * torch.nn.functional.l1_loss(x_hat, x)
-    else:
-        mse = torch.nn.functional.mse_loss(x_hat, x)  # one fused kernel: mean over M and K
-        reconstruction = 0.5 * alpha * mse
-    kl = torch.mean(kl_divergence(mu, sigma, sigma_object, prior_form))
-    return {"total": reconstruction + kl, "reconstruction": reconstruction, "kl": kl, "mse": mse.detach()}

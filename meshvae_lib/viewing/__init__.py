@@ -20,51 +20,46 @@ module                      public names
 ``widgets``                 ``FramePlayer``, ``InterpolationSlider``
 ``explorer``                ``LatentExplorer``
 ``latent_pad``              ``LatentPad``
+``convergence_curves``      ``convergence_figure``, ``epochs_past_best``
+``embedding_maps``          ``embedding_maps_figure``
+``interpolation_measures``  ``interpolation_measures_figure``
+``marked_vertices``         ``marked_vertices_figure``
+``normalization_margins``   ``normalization_margin_figure``
+``rimd_diagrams``           ``feature_layout_figure``, ``polar_decomposition_figure``
+``network_diagram``,        ``network_diagram``, ``one_ring_figure``, ``pipeline_diagram``,
+``one_ring_figure``, ...    ``readable_figure`` (each the name of its own module: imported with
+                            the package, so that the module never hides the function)
 ==========================  =====================================================================
 """
 
 from __future__ import annotations
 
-import importlib
+from meshvae_lib.exports import exports_of, lazy_exports
+# names that are also their module's name: imported here (light modules, no matplotlib)
+from meshvae_lib.viewing.network_diagram import network_diagram
+from meshvae_lib.viewing.one_ring_figure import one_ring_figure
+from meshvae_lib.viewing.pipeline_diagram import pipeline_diagram
+from meshvae_lib.viewing.readable_figure import readable_figure
 
-_NAMES = {
-    "position_buffer": "buffers",
-    "normal_buffer": "buffers",
-    "index_buffer": "buffers",
-    "color_buffer": "buffers",
-    "row_offsets": "buffers",
-    "fit_camera": "buffers",
-    "ColorMapping": "colors",
-    "scalar_colors": "colors",
-    "error_colors": "colors",
-    "label_colors": "colors",
-    "colorbar_html": "colors",
-    "legend_html": "colors",
-    "gallery_indices": "gallery",
-    "mesh_caption": "gallery",
-    "angular_stripes": "gallery",
-    "render_mesh": "render",
-    "render_mesh_grid": "render",
-    "figure_to_png": "render",
-    "resolve_mode": "fallback",
-    "ImageView": "fallback",
-    "MeshViewer": "viewer",
-    "FramePlayer": "widgets",
-    "LatentExplorer": "explorer",
-    "LatentPad": "latent_pad",
-    "InterpolationSlider": "widgets",
-}
+#: module (under this package) and the public names it defines, one line each.
+EXPORTS = exports_of(__name__, """
+buffers                 position_buffer normal_buffer index_buffer color_buffer row_offsets fit_camera
+colors                  ColorMapping scalar_colors error_colors label_colors colorbar_html legend_html
+gallery                 gallery_indices mesh_caption angular_stripes
+render                  render_mesh render_mesh_grid figure_to_png
+fallback                resolve_mode ImageView
+viewer                  MeshViewer
+widgets                 FramePlayer InterpolationSlider
+explorer                LatentExplorer
+latent_pad              LatentPad
+convergence_curves      convergence_figure epochs_past_best
+embedding_maps          embedding_maps_figure
+interpolation_measures  interpolation_measures_figure
+marked_vertices         marked_vertices_figure
+normalization_margins   normalization_margin_figure
+rimd_diagrams           feature_layout_figure polar_decomposition_figure
+""")
 
-__all__ = sorted(_NAMES)
+__all__ = sorted([*EXPORTS, "network_diagram", "one_ring_figure", "pipeline_diagram", "readable_figure"])
 
-
-def __getattr__(name: str):
-    try:
-        module = _NAMES[name]
-    except KeyError:
-        raise AttributeError(f"module 'meshvae_lib.viewing' has no attribute {name!r}") from None
-    return getattr(importlib.import_module(f"{__name__}.{module}"), name)
-
-
-def __dir__():
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports(__name__, EXPORTS)

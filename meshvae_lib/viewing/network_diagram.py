@@ -1,7 +1,7 @@
 """The mesh VAE as a diagram: its layers left to right, each with its size (notebook 04).
 
-:func:`network_layers` lists the stages of a :class:`~meshvae_lib.model.vae.MeshVAE` (or of a
-fitted :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`) as plain values;
+:func:`network_layers` lists the stages of a :class:`~meshvae_lib.model.vae.MeshVAE` (read from its
+``config()``, so that this layer needs nothing of the model layer) as plain values;
 :func:`network_diagram` draws them with matplotlib, one row per network, so that a network
 without internal layers can be set beside one with them.
 """
@@ -13,20 +13,26 @@ import math
 __all__ = ["network_layers", "network_diagram"]
 
 
-def _network(net):
-    """The ``MeshVAE`` of a network or of a fitted model (anything with a ``network`` attribute)."""
-    inner = getattr(net, "network", None)
-    net = inner if inner is not None and not callable(getattr(net, "encode", None)) else net
-    for name in ("n_features", "latent_dim", "hidden", "input_rank", "output", "sigma_max"):
-        if not hasattr(net, name):
-            raise TypeError(f"expected a MeshVAE network or a fitted MeshVAEModel, got {type(net).__name__}")
-    return net
+#: what :func:`network_layers` reads of a mesh VAE's ``config()``.
+_CONFIG_KEYS = ("n_features", "latent_dim", "hidden", "n_conditions", "input_rank", "output")
+
+
+def _mesh_vae_config(net) -> dict:
+    """A mesh VAE network's ``config()``; TypeError naming the type for anything else."""
+    try:
+        config = net.config()
+    except AttributeError:            # not a network
+        config = None
+    if not isinstance(config, dict) or not set(_CONFIG_KEYS) <= set(config):
+        raise TypeError(f"expected a MeshVAE network (its config() has {', '.join(_CONFIG_KEYS)}),"
+                        f" got {type(net).__name__}")
+    return config
 
 
 def network_layers(net) -> list[dict]:
     """The stages of a mesh VAE network, input to output.
 
-    net : a :class:`~meshvae_lib.model.vae.MeshVAE` or a fitted ``MeshVAEModel``.
+    net : a :class:`~meshvae_lib.model.vae.MeshVAE` (a fitted model's is ``model.network``).
     Returns a list of dicts ``{"label", "size", "kind", "weights"}``: ``kind`` is "data" (the
     feature vector in and out), "fixed" (the PCA start's input projection, not trained), "hidden"
     (``Linear -> BatchNorm -> LeakyReLU``), "latent" (the heads mu and sigma, and z) or "output"
@@ -35,16 +41,16 @@ def network_layers(net) -> list[dict]:
     projection's numbers for "fixed"). The encoder's two heads are one stage (label mu, sigma in
     matplotlib's mathtext) of size D (each).
     """
-    net = _network(net)
-    K, D, C = int(net.n_features), int(net.latent_dim), int(getattr(net, "n_conditions", 0))
-    r = int(net.input_rank)
+    config = _mesh_vae_config(net)
+    K, D, C = int(config["n_features"]), int(config["latent_dim"]), int(config["n_conditions"])
+    r, hidden = int(config["input_rank"]), [int(h) for h in config["hidden"]]
     stages = [{"label": "RIMD feature\n(normalised)", "size": K, "kind": "data", "weights": 0}]
     width = K
     if r:
         stages.append({"label": "PCA projection\n(fixed)", "size": r, "kind": "fixed", "weights": r * K + K})
         width = r
     width += C
-    for h in net.hidden:
+    for h in hidden:
         stages.append({"label": "Linear, BatchNorm,\nLeakyReLU", "size": int(h), "kind": "hidden",
                        "weights": width * int(h) + int(h) + 2 * int(h)})
         width = int(h)
@@ -52,11 +58,11 @@ def network_layers(net) -> list[dict]:
                    "weights": width * 2 * D + 2 * D})
     stages.append({"label": "$z = \\mu + \\sigma \\odot \\varepsilon$", "size": D, "kind": "latent", "weights": 0})
     width = D + C
-    for h in reversed(net.hidden):
+    for h in reversed(hidden):
         stages.append({"label": "Linear, BatchNorm,\nLeakyReLU", "size": int(h), "kind": "hidden",
                        "weights": width * int(h) + int(h) + 2 * int(h)})
         width = int(h)
-    stages.append({"label": f"Linear, then\n{net.output}", "size": K, "kind": "output", "weights": width * K + K})
+    stages.append({"label": f"Linear, then\n{config['output']}", "size": K, "kind": "output", "weights": width * K + K})
     return stages
 
 
@@ -74,7 +80,7 @@ def _count(n: int) -> str:
 def network_diagram(networks, titles=None, width: float = 10.0, row_height: float = 2.4):
     """Draw mesh VAE networks as boxes left to right, one row per network.
 
-    networks : a network (``MeshVAE`` or fitted ``MeshVAEModel``) or a list of them; titles : one
+    networks : a ``MeshVAE`` network or a list of them; titles : one
     title per row or None. Each stage of :func:`network_layers` is a box whose height grows with
     the logarithm of its size, labelled with what it is and its size (``K = 16428``, ``D = 32``);
     the arrow into a box carries the number of trained weights of the linear map that produces it

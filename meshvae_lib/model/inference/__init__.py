@@ -46,6 +46,8 @@ def make_inference(spec, **options):
         if unknown:
             raise ValueError(f"inference {spec!r} takes the options {cls.options or '()'}, got {unknown}")
         return cls(**options)
-    if not hasattr(spec, "infer") or options:
+    from meshvae_lib.model.inference.base import InferenceStrategy
+
+    if not isinstance(spec, InferenceStrategy) or options:
         raise ValueError(f"inference must be one of {tuple(METHODS)} or a strategy, got {spec!r}")
     return spec

@@ -11,7 +11,8 @@ class InferenceStrategy:
     """How a fitted model finds latent codes for meshes.
 
     A subclass sets ``name`` (its registry key) and ``options`` (its constructor keywords, stored as
-    attributes) and writes :meth:`infer`. ``iterations`` is the number of refinement steps after
+    instance attributes of the same names) and writes :meth:`infer`; one with something to say about
+    its latest call overrides :meth:`report`. ``iterations`` is the number of refinement steps after
     the encoder (0 for the encoder itself): what ``evaluate_model`` reports.
     """
 
@@ -25,9 +26,14 @@ class InferenceStrategy:
         unconditional model); ``progress``: a progress bar over the meshes where the work is long."""
         raise NotImplementedError
 
+    def report(self) -> object | None:
+        """What the latest :meth:`infer` did (the estimator keeps it as ``last_inference_``), or
+        None: a strategy with nothing to report (the default)."""
+        return None
+
     def get_options(self) -> dict:
         """``{keyword: value}`` of the strategy's options (what rebuilds it)."""
-        return {k: getattr(self, k) for k in self.options}
+        return {k: vars(self)[k] for k in self.options}
 
     def describe(self) -> str:
         """A few words for reports: how the codes were found."""

@@ -1,8 +1,8 @@
 """Semi-amortised inference (the default): the encoder's mean, then a few damped Gauss-Newton
 (Levenberg-Marquardt) steps on the decoded mesh's squared vertex error,
 ``min_z min_(R,t) sum_k |decode(z)_k - (R x_k + t)|^2``, with the **analytic** Jacobian of decoder
-and reconstruction: :func:`~meshvae_lib.model.networks.decoder_linearization` (the network, then the affine maps of the output range
-and Eq. 3) times the feature kind's linearisation (``FeatureKind.linearize``; for RIMD
+and reconstruction: the network's public linearisation (``Network.linearization``; then the affine
+maps of the output range and Eq. 3) times the feature kind's linearisation (``FeatureKind.linearize``; for RIMD
 :mod:`~meshvae_lib.geometry.reconstruction_linearization`). One step costs one Jacobian (two
 factorised sparse solves per latent dimension) and usually one decode. On real collections the
 encoder alone spends its code on feature directions that barely move the vertices (docs/vae.md,
@@ -11,21 +11,19 @@ encoder alone spends its code on feature directions that barely move the vertice
 The rigid motion is eliminated by projecting the six rigid vertex fields (three translations,
 three rotations about the centroid) out of the Jacobian and aligning the target to each decoded
 mesh; the model's decoder, normaliser and reconstruction are not changed. The network's Jacobian
-comes through its public protocol (:mod:`~meshvae_lib.model.networks`): the mesh VAE's closed form,
-or autograd for any other registered network, so every network gets this inference.
+comes through the network contract (:mod:`~meshvae_lib.model.network_base`): the mesh VAE's closed
+form (its own override), or autograd for any other registered network, so every network gets this
+inference.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import torch
 
 from meshvae_lib.defaults import GAUSS_NEWTON_ITERATIONS
 from meshvae_lib.model.inference.base import InferenceStrategy
 from meshvae_lib.model.inference.least_squares import (  # noqa: F401 (re-exported)
     FitState, MarquardtFit, marquardt_fit, rigid_fields, without_rigid_motions)
-from meshvae_lib.model.networks import decoder_linearization
-from meshvae_lib.model.vae_linearization import output_slope
 from meshvae_lib.validation import check_count
 from meshvae_lib.workers import map_forked, resolve_jobs
 
@@ -58,57 +56,35 @@ class GaussNewtonReport:
 
 
 class LatentDecoder:
-    """Codes -> features and their Jacobian for one model, with the network's weights converted once.
-
-    A network whose decoder is one linear map and an activation (``linear_decoder()``, the default
-    mesh VAE) is evaluated here in float64 on its used columns only; any other through
-    :func:`~meshvae_lib.model.networks.decoder_linearization` at every state.
+    """Codes -> features and their Jacobian for one model, through the network's public
+    linearisation (``network.linearization(used)``: built once, e.g. the mesh VAE's used weight
+    columns converted to float64 once; evaluated at every state).
 
     Attributes
     ----------
     used : (n_used,) int64, the latent dimensions the decoder reads (``model.used_latent_dims``).
     offset, scale : (K,) float64, features = offset + scale * network rows.
-    linear : bool, the fast path; then ``W (K, n_used)``, ``b (K,)`` and ``Wc (K, C)`` float64, the
-        output layer's used columns, bias and condition columns.
+    linearization : the network's :class:`~meshvae_lib.model.linearization.DecoderLinearization`.
     """
 
     def __init__(self, model, conditions: np.ndarray | None):
         net = model.network
         self.kind, self.network, self.conditions = model.feature_kind, net, conditions
-        K, D = net.n_features, net.latent_dim
+        K = net.n_features
         # rows -> features is affine per column (the output range, then Eq. 3 inverted)
         self.offset = np.asarray(model.features_from_rows(np.zeros((1, K))), dtype=np.float64)[0]
         self.scale = np.asarray(model.features_from_rows(np.ones((1, K))), dtype=np.float64)[0] - self.offset
         self.used = np.asarray(model.used_latent_dims, dtype=np.int64)
-        linear = net.linear_decoder() if callable(getattr(net, "linear_decoder", None)) else None
-        self.linear = linear is not None
-        if not self.linear:
-            return
-        # the output layer's weights (K x D, K ~ 1e5-1e6) are selected in torch's float32 and only the
-        # used columns converted: converting all of them first took 0.3 s per call at 10k vertices
-        W, b = linear
-        self.W = W.index_select(1, torch.from_numpy(self.used)).double().numpy()
-        self.b = b.double().numpy()
-        self.Wc = W[:, D:].double().numpy()
+        self.linearization = net.linearization(self.used)
 
     def state(self, z: np.ndarray, c, x: np.ndarray) -> "_DecodedState":
         """The decoded mesh of code ``z (D,)`` against the target ``x (n, 3)``, with what its Jacobian needs."""
-        if self.linear:
-            y = self.W @ z[self.used] + self.b
-            if self.network.n_conditions:
-                y = y + self.Wc @ np.asarray(c, dtype=np.float64)
-            rows, slope = output_slope(self.network.output, y)
-            network_jacobian = None
-        else:
-            rows, network_jacobian = decoder_linearization(self.network, z, c)
-            slope = None
-        return _DecodedState(self.kind.linearize(self.offset + self.scale * rows), x, slope, network_jacobian)
+        point = self.linearization.at(z, c)
+        return _DecodedState(self.kind.linearize(self.offset + self.scale * point.rows), x, point)
 
     def feature_jacobian(self, state: "_DecodedState") -> np.ndarray:
         """d features / d z[used] at a decoded state: (K, n_used) float64."""
-        if self.linear:
-            return (self.scale * state.slope)[:, None] * self.W
-        return self.scale[:, None] * state.network_jacobian[:, self.used]
+        return state.point.jacobian(self.scale)
 
     def vertex_jacobian(self, state: "_DecodedState") -> np.ndarray:
         """d positions / d z[used] at a decoded state, rigid motions projected out: (3 n, n_used) float64."""
@@ -117,11 +93,11 @@ class LatentDecoder:
 
 
 class _DecodedState(FitState):
-    """A decoded code: :class:`FitState` plus what the network's Jacobian needs: the output's slope
-    ``(K,)`` for a linear decoder, else the network's Jacobian ``(K, D)`` computed with the rows."""
+    """A decoded code: :class:`FitState` plus the network's linearisation at the code (its
+    :class:`~meshvae_lib.model.linearization.DecoderPoint`)."""
 
-    def __init__(self, lin, x: np.ndarray, slope: np.ndarray | None, network_jacobian: np.ndarray | None):
-        self.slope, self.network_jacobian = slope, network_jacobian
+    def __init__(self, lin, x: np.ndarray, point):
+        self.point = point
         super().__init__(lin, x)
 
 
@@ -223,6 +199,10 @@ class GaussNewton(InferenceStrategy):
         resolve_jobs(n_jobs, 1)            # checked here, resolved per call
         self.n_jobs = n_jobs
         self.report_ = None
+
+    def report(self) -> "GaussNewtonReport | None":
+        """:attr:`report_`: the latest :meth:`infer`'s errors, steps and decodes per mesh."""
+        return self.report_
 
     def describe(self) -> str:
         chord = f" (+{self.chord_steps} chord each)" if self.chord_steps else ""
