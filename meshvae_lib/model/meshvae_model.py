@@ -23,6 +23,7 @@ import numpy as np
 import torch
 
 from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INFERENCE, DEFAULT_LAYOUT
+from meshvae_lib.geometry.collection import mesh_digests
 from meshvae_lib.model import checkpoint
 from meshvae_lib.model.conditions import ConditionEncoder
 from meshvae_lib.model.feature_kinds import kind_from_state, make_kind
@@ -37,7 +38,7 @@ __all__ = ["MeshVAEModel", "load_model", "FITTED_ATTRIBUTES"]
 
 #: the attributes :meth:`MeshVAEModel.fit` sets and :func:`load_model` restores, all of them.
 FITTED_ATTRIBUTES = ("network_", "normalizer_", "kind_", "conditions_", "train_conditions_", "sigma_object_",
-                     "holdout_mask_", "train_config_", "history_", "train_seconds_", "train_epochs_", "selection_")
+                     "holdout_mask_", "mesh_digests_", "train_config_", "history_", "train_seconds_", "train_epochs_", "selection_")
 _HINT = "call fit(collection) or load_model(path) first"
 
 
@@ -70,6 +71,10 @@ class MeshVAEModel:
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
     holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
+    mesh_digests_ : list of N str, the identity of each mesh of the training collection
+        (:func:`~meshvae_lib.geometry.collection.mesh_digests` of its vertices), so that its held-out
+        and training meshes are found again in a collection in any order; None for a model read
+        from a checkpoint of format 3 or older.
     train_config_ : TrainConfig the network was trained with (``config`` or the defaults, its latent
         size resolved; ``config`` itself is left as given).
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`).
@@ -128,6 +133,7 @@ class MeshVAEModel:
         self.history_, self.train_seconds_ = result.history, result.seconds
         self.train_epochs_, self.selection_ = result.epochs, result.selection
         self.holdout_mask_ = mask
+        self.mesh_digests_ = mesh_digests(V)
         self.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
         self.sigma_object_ = so if so is not None and config.prior_form == "exact" else np.ones(D)
         self.train_config_ = TrainConfig(**{**config.to_dict(), "latent_dim": D})
@@ -334,6 +340,7 @@ class MeshVAEModel:
             "train_config": self.train_config_.to_dict(),
             "estimator": self._params(),
             "holdout_mask": np.asarray(self.holdout_mask_, dtype=bool),
+            "mesh_digests": None if self.mesh_digests_ is None else list(self.mesh_digests_),
             "history": [dict(h) for h in self.history_],
             "train_seconds": float(self.train_seconds_),
             "train_epochs": int(self.train_epochs_),
@@ -358,6 +365,10 @@ class MeshVAEModel:
         model.train_conditions_ = np.asarray(state["train_conditions"], dtype=np.float32)
         model.sigma_object_ = np.asarray(state["sigma_object"], dtype=np.float64)
         model.holdout_mask_ = np.asarray(state["holdout_mask"], dtype=bool)
+        digests = state.get("mesh_digests")
+        model.mesh_digests_ = None if digests is None else [str(d) for d in digests]
+        if digests is not None and len(digests) != len(model.holdout_mask_):
+            raise ValueError(f"its parts disagree: {len(digests)} mesh digests for {len(model.holdout_mask_)} meshes")
         model.train_config_ = config
         model.history_ = list(state["history"])
         model.train_seconds_ = float(state["train_seconds"])
