@@ -458,7 +458,7 @@ def _make_old(d: Path, kind: str | None, command: str) -> dict | None:
     else:
         (d / OUT["folder"]).mkdir()
         (d / OUT["folder"] / "0000.obj").write_bytes(b"# old mesh\n" + rng.bytes(500))
-        (d / OUT["folder"] / "notes.txt").write_text("the user's own file\n")
+        (d / OUT["folder"] / "labels.csv").write_text("name,pose\n0000,old\n")
     return _snapshot(d)
 
 
@@ -580,16 +580,21 @@ def test_atomic_folder_new_and_existing(tmp_path):
     assert (tmp_path / "new" / "deep" / "a.txt").read_text() == "a"
     old = tmp_path / "old"
     old.mkdir()
-    (old / "keep.txt").write_text("mine")
+    (old / "b.txt").write_text("old b")
     (old / "a.txt").write_text("old a")
     with pytest.raises(RuntimeError):
         with atomic.atomic_folder(old) as tmp:
             (tmp / "a.txt").write_text("new a")
             raise RuntimeError("fails midway")
-    assert (old / "a.txt").read_text() == "old a"
-    with atomic.atomic_folder(old) as tmp:
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt", "b.txt"] and (old / "a.txt").read_text() == "old a"
+    with atomic.atomic_folder(old, outputs=(".txt",)) as tmp:  # replaced as a whole: b.txt is gone
         (tmp / "a.txt").write_text("new a")
-    assert (old / "a.txt").read_text() == "new a" and (old / "keep.txt").read_text() == "mine"
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt"] and (old / "a.txt").read_text() == "new a"
+    (old / "mine.dat").write_text("the user's own file")
+    with pytest.raises(ValueError, match=r"it holds 1 file\(s\) or folder\(s\) that are not outputs \('mine.dat'\)"):
+        with atomic.atomic_folder(old, outputs=(".txt",)) as tmp:
+            (tmp / "a.txt").write_text("newer a")
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt", "mine.dat"] and (old / "a.txt").read_text() == "new a"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 

@@ -152,15 +152,20 @@ def check_budget(n_meshes: int, n_vertices: int, option: str) -> None:
 def check_output(path, *, collection: bool = False, parents: bool = False):
     """The ``-o`` of a command, checked before any work: :class:`UsageError` unless it can be
     written (``meshvae_lib.atomic.check_writable``). ``collection``: an ``.npz`` file when ``path``
-    ends in ``.npz``, else a folder; ``parents``: missing parent folders will be created. Returns
-    the path as a ``Path``."""
+    ends in ``.npz``, else a folder of meshes (an existing one is replaced as a whole, so it must
+    hold only meshes and ``labels.csv``); ``parents``: missing parent folders will be created.
+    Returns the path as a ``Path``."""
     from pathlib import Path
 
     from meshvae_lib.atomic import check_writable
 
     path = Path(path)
+    folder = collection and path.suffix.lower() != ".npz"
+    outputs = None
+    if folder:
+        from meshvae_lib.geometry.collection_io import FOLDER_OUTPUTS as outputs
     try:
-        return check_writable(path, folder=collection and path.suffix.lower() != ".npz", parents=parents)
+        return check_writable(path, folder=folder, parents=parents, outputs=outputs)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 

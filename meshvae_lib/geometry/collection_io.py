@@ -31,9 +31,14 @@ from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
 from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.input_checks import check_numeric, short_name
 
-__all__ = ["read_collection", "write_collection", "natural_key", "open_npz", "npz_array", "npz_names"]
+__all__ = ["read_collection", "write_collection", "natural_key", "open_npz", "npz_array", "npz_names", "FOLDER_OUTPUTS"]
 
 logger = logging.getLogger(__name__)
+
+#: what a collection folder that :func:`write_collection` replaces may hold: mesh files and
+#: ``labels.csv`` (``meshvae_lib.atomic.check_writable``'s ``outputs``); a folder holding anything
+#: else is refused rather than replaced.
+FOLDER_OUTPUTS = (*MESH_SUFFIXES, "labels.csv")
 
 
 def natural_key(name: str) -> list:
@@ -321,8 +326,9 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
     float64 precision in both formats.
 
     Writing is atomic (:mod:`meshvae_lib.atomic`): the ``.npz`` through a temporary file, the folder
-    through a temporary folder whose files then take their places (other files in an existing
-    folder are left alone). A failed write leaves the old output as it was and raises
+    through a temporary folder that replaces an existing folder as a whole (so it holds exactly the
+    new meshes; a folder holding files other than :data:`FOLDER_OUTPUTS` raises ValueError and is
+    left alone). A failed write leaves the old output as it was and raises
     :class:`~meshvae_lib.atomic.OutputError` (``cannot write FILE: reason``).
 
     Parameters
@@ -366,7 +372,7 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
         stems = [
             f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)[:FILE_NAME_CHARS]}" for k, s in enumerate(stems)
         ]
-    with atomic_folder(path) as tmp:
+    with atomic_folder(path, outputs=FOLDER_OUTPUTS) as tmp:
         for V, stem in zip(col.vertices, stems):
             write_mesh(tmp / f"{stem}.obj", V, col.faces)
         if col.labels:
