@@ -53,6 +53,9 @@ EXIT_USAGE = 2
 MESSAGE_CHARS = 500
 #: exit status: interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
+#: exit status: stdout was closed by its reader (``meshvae ... | head``): the command ends quietly,
+#: with the status shells report for a command ended by SIGPIPE (128 + 13), as ``cat`` does.
+EXIT_BROKEN_PIPE = 141
 
 EPILOG = """\
 exit status:
@@ -62,8 +65,11 @@ exit status:
      missing or unknown file or mesh name, a damaged checkpoint, a model that does not fit the data,
      an output that cannot be written (all checked before any work)
   130  interrupted (Ctrl-C): nothing half-written is left
+  141  stdout was closed by its reader (`meshvae ... | head`): the command ends quietly, as `cat`
+       does (a full stdout, e.g. /dev/full, is an error: status 1)
 
-outputs are written atomically: a failed write ("cannot write FILE: reason") keeps the old file.
+outputs are written atomically: a failed write ("cannot write FILE: reason") keeps the old file;
+a folder output replaces an existing folder of meshes as a whole (never merged with it).
 
 output: results and "wrote ..." lines go to stdout; progress bars, warnings and errors
 (one line: "meshvae COMMAND: error: ...") go to stderr.
@@ -92,14 +98,33 @@ def exit_status(exc: BaseException) -> int:
     return EXIT_USAGE if isinstance(exc, USAGE_ERRORS) else EXIT_FAILURE
 
 
+def printable(text: str) -> str:
+    """``text`` with control characters (a terminal's escape sequences, carriage returns, a bidi
+    override) written as escapes, ``\\x1b``, so that echoing a name cannot act on the terminal; line
+    breaks are kept."""
+    if text.isprintable():
+        return text
+    return "\n".join("".join(c if c.isprintable() else repr(c)[1:-1] for c in line) for line in text.split("\n"))
+
+
 def result(text: str) -> None:
-    """A line of the command's output (results, "wrote ..."): stdout."""
-    print(text, file=sys.stdout)
+    """A line of the command's output (results, "wrote ..."): stdout, flushed at once, so that a
+    full stdout is reported as ``cannot write stdout: reason`` (:class:`~meshvae_lib.atomic.OutputError`,
+    exit status 1) and a reader that has gone (``| head``) ends the command quietly
+    (``BrokenPipeError``, :data:`EXIT_BROKEN_PIPE`)."""
+    try:
+        print(printable(text), file=sys.stdout, flush=True)
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        from meshvae_lib.atomic import OutputError
+
+        raise OutputError("stdout", exc.strerror or str(exc), exc.errno) from None
 
 
 def note(text: str) -> None:
     """A progress or warning line, not part of the output: stderr."""
-    print(text, file=sys.stderr)
+    print(printable(text), file=sys.stderr)
 
 
 # --- shared arguments --------------------------------------------------------------------------
@@ -302,6 +327,17 @@ def run() -> None:
     except KeyboardInterrupt:  # a second Ctrl-C while the first was being reported
         print("meshvae: interrupted", file=sys.stderr)
         status = EXIT_INTERRUPTED
+    except SystemExit as exc:  # argparse: --help, --version (0), a usage error (2)
+        status = exc.code if isinstance(exc.code, int) else (EXIT_OK if exc.code is None else EXIT_USAGE)
+    try:  # what is left in stdout's buffer (argparse's --help): a reader that has gone ends quietly
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_stdout()
+        status = EXIT_BROKEN_PIPE
+    except OSError as exc:
+        _quiet_stdout()
+        print(f"meshvae: error: cannot write stdout: {exc.strerror or exc}", file=sys.stderr)
+        status = status or EXIT_FAILURE
     if status == EXIT_INTERRUPTED:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         # CPython ends a process by SIGINT (status -2, not 130) whenever a KeyboardInterrupt once escaped
@@ -316,6 +352,36 @@ def run() -> None:
                 pass
         os._exit(status)
     sys.exit(status)
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at the null device, so that the interpreter's last flush at exit finds nothing to
+    complain about (a reader that has gone, a full disk)."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):  # no real file behind stdout (a test's capture)
+        pass
+
+
+def _message(exc: BaseException, command: str) -> tuple[str, int]:
+    """The one-line message and exit status of a command that raised ``exc``."""
+    import errno
+
+    status = exit_status(exc)
+    expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
+    if isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG:  # a name given on the command line
+        from meshvae_lib.input_checks import short_name
+
+        name = exc.filename if exc.filename is not None else ""
+        return f"{short_name(os.path.basename(str(name)) or name)}: the file name is too long for the file system", EXIT_USAGE
+    text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
+    if len(text) > MESSAGE_CHARS:  # a long name or a library's long text: the start and the end
+        text = f"{text[: MESSAGE_CHARS - 200]} ... {text[-150:]}"
+    if not expected:
+        text += f" (run `meshvae -v {command} ...` for the traceback)"
+    return text, status
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -347,17 +413,14 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt:  # Ctrl-C: the writers leave nothing half-written; no traceback
         print(f"meshvae {args.command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # stdout's reader has gone (`| head`): nothing more to say, to anyone
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
     except Exception as exc:  # one line on stderr, no traceback; the status says whose fault it is
-        status = exit_status(exc)
-        expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
-        text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
-        if len(text) > MESSAGE_CHARS:  # a long name or a library's long text: the start and the end
-            text = f"{text[: MESSAGE_CHARS - 200]} ... {text[-150:]}"
-        if not expected:
-            text += f" (run `meshvae -v {args.command} ...` for the traceback)"
+        text, status = _message(exc, args.command)
         if args.verbose:
             logger.error("traceback of the error below", exc_info=exc)
-        print(f"meshvae {args.command}: error: {text}", file=sys.stderr)
+        print(printable(f"meshvae {args.command}: error: {text}").replace("\n", " "), file=sys.stderr)
         return status
 
 
