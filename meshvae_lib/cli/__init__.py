@@ -271,8 +271,14 @@ def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: 
     except (OSError, ValueError):  # a name too long for the file system, a NUL byte
         is_file = False
     if not is_file:
+        shown = short_name(repr(spec))
+        if _is_dir(path):
+            raise UsageError(f"{option} {shown} is a folder, not a mesh file{hint}")
+        if path.suffix or os.sep in spec:  # meant as a file: say it is not there
+            where = "; nor is it a mesh name of the collection" if collection is not None else ""
+            raise UsageError(f"{option} {shown}: no such mesh file{where}{hint}")
         what = "neither an index, a mesh name of the collection, nor" if collection is not None else "not"
-        raise UsageError(f"{option} {short_name(repr(spec))} is {what} a mesh file{hint}")
+        raise UsageError(f"{option} {shown} is {what} a mesh file{hint}")
     import numpy as np
 
     from meshvae_lib.geometry.mesh_files import read_mesh
@@ -284,6 +290,13 @@ def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: 
             raise UsageError(f"{option} {short_name(path.name)}: its connectivity ({len(V)} vertices, {len(F)} faces)"
                              f" differs from {owner} ({n_vertices} vertices, {len(faces)} faces)")
     return ChosenMesh(V, path.stem, file=short_name(path.name))
+
+
+def _is_dir(path) -> bool:
+    try:
+        return path.is_dir()
+    except (OSError, ValueError):
+        return False
 
 
 # --- the command line --------------------------------------------------------------------------

@@ -66,12 +66,13 @@ def _names(names) -> str:
 def _read_labels_csv(path: Path, names: list[str]) -> dict[str, np.ndarray]:
     """The label columns of a folder's ``labels.csv``: one row per mesh, in ``names``' order.
 
-    Raises ``ValueError`` naming the file and the line for a header without ``name`` first, an
+    The file is UTF-8, with or without a byte-order mark. Raises ``ValueError`` naming the file and
+    the line for a header without ``name`` first, an
     empty row (blank lines at the end are allowed), a row with another number of fields, an empty
     mesh name or label value, a mesh named twice, and rows missing or naming no mesh.
     """
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark (Excel's UTF-8 CSV) is skipped
             rows = list(enumerate(csv.reader(fh), start=1))
     except (UnicodeDecodeError, csv.Error) as exc:
         raise ValueError(f"{path}: is not a readable CSV file ({short_name(exc, 120)})") from None
@@ -210,9 +211,12 @@ def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
                 f"{src}: 'faces' must be triangles with shape (F, 3), got {faces.shape}"
             )
         n = len(vertices)
+        if n == 0:
+            raise ValueError(f"{src}: holds no meshes ('vertices' has shape {vertices.shape})")
         names = (npz_names(data, "names", path) if "names" in data.files else default_names(n))
         if len(names) != n:
             raise ValueError(f"{src}: {len(names)} names for {n} meshes")
+        _check_distinct_names(names, src)
         labels = {}
         for key in data.files:
             if key.startswith("label_"):
@@ -226,6 +230,20 @@ def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
                 labels[key[len("label_"):]] = val
     _validate_collection(vertices, faces, names, src, allow_degenerate)
     return MeshCollection(vertices, faces.astype(np.int64), names, labels)
+
+
+def _check_distinct_names(names: list[str], src: str) -> None:
+    """ValueError naming the first mesh name that ``names`` holds twice (a name must pick one mesh)."""
+    first: dict[str, int] = {}
+    for k, name in enumerate(names):
+        if name in first:
+            raise ValueError(f"{src}: mesh name {short_name(repr(name))} is given twice (meshes {first[name]} and {k});"
+                             " every mesh needs its own name")
+        first[name] = k
+
+
+#: how the files :func:`open_npz` reads begin: a zip archive (an ``.npz``) or a ``.npy`` array.
+_NPZ_MAGIC = (b"PK\x03\x04", b"PK\x05\x06", b"\x93NUMPY")
 
 
 def open_npz(path):
@@ -246,6 +264,15 @@ def open_npz(path):
         The file is not an ``.npz`` archive (or is damaged).
     """
     path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(6)
+    except OSError:
+        head = _NPZ_MAGIC[0]  # np.load reports it
+    if not head.startswith(_NPZ_MAGIC):  # np.load would take it for a pickle and blame pickled data
+        what = "it is empty" if not head else f"it does not start like one (first bytes {head[:4]!r})"
+        raise ValueError(f"{short_name(path.name)}: cannot be read as .npz: {what}; an .npz is a zip archive"
+                         " of named arrays (numpy.savez)")
     try:
         data = np.load(path, allow_pickle=False)
     except Exception as exc:
@@ -365,13 +392,11 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
             np.savez_compressed(fh, **arrays)
         return path
     stems = list(col.names)
-    safe = (all(re.fullmatch(r"[\w.+-]+", s) and len(s) <= FILE_NAME_CHARS for s in stems)
+    safe = (all(_FILE_NAME.fullmatch(s) and len(s.encode()) <= FILE_NAME_CHARS for s in stems)
             and len(set(stems)) == len(stems))
     if not safe or sorted(stems, key=natural_key) != stems:
         width = max(4, len(str(len(stems) - 1)))
-        stems = [
-            f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)[:FILE_NAME_CHARS]}" for k, s in enumerate(stems)
-        ]
+        stems = [f"{k:0{width}d}_{_file_name_part(s)}" for k, s in enumerate(stems)]
     with atomic_folder(path, outputs=FOLDER_OUTPUTS) as tmp:
         for V, stem in zip(col.vertices, stems):
             write_mesh(tmp / f"{stem}.obj", V, col.faces)
@@ -383,6 +408,18 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
                 for k, stem in enumerate(stems):
                     w.writerow([stem, *[_fmt_label(col.labels[c][k]) for c in keys]])
     return path
+
+
+#: a mesh name usable as a file name as it is: letters and digits of any script, ``_ . + -``.
+_FILE_NAME = re.compile(r"[\w.+-]+")
+
+
+def _file_name_part(name: str) -> str:
+    """``name`` made usable in a file name: runs of other characters (spaces, slashes, control
+    characters) become ``_``, letters of any script are kept, cut to ``FILE_NAME_CHARS`` bytes of
+    UTF-8 (file systems count bytes)."""
+    text = re.sub(r"[^\w.+-]+", "_", name).encode()[:FILE_NAME_CHARS]
+    return text.decode(errors="ignore")
 
 
 def _fmt_label(v) -> str:
