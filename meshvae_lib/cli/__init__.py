@@ -159,6 +159,15 @@ def check_number(value: float, option: str, *, positive: bool = True) -> None:
         raise UsageError(f"{option} must be a finite number{' > 0' if positive else ''}, got {value}")
 
 
+def check_seed(value: int, option: str = "--seed") -> None:
+    """:class:`UsageError` unless ``value`` is a seed every generator takes: 0 <= value <= ``MAX_SEED``
+    (``defaults``)."""
+    from meshvae_lib.defaults import MAX_SEED
+
+    check_at_least(value, 0, option)
+    check_at_most(value, MAX_SEED, option, "a 64-bit seed")
+
+
 def check_budget(n_meshes: int, n_vertices: int, option: str) -> None:
     """:class:`UsageError` unless ``n_meshes`` meshes of ``n_vertices`` vertices fit in one run's
     budget of ``MAX_OUTPUT_VERTICES`` decoded vertices (``defaults``); the message gives the size,
