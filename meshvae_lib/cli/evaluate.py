@@ -68,12 +68,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+def _file(text: str) -> str:
+    """A file given on the command line as its messages name it: its name, cut to a readable length."""
+    from pathlib import Path
+
+    from meshvae_lib.input_checks import short_name
+
+    return short_name(Path(text).name or text)
+
+
 def _compatible(model, collection, what: str) -> None:
     """:class:`UsageError` naming ``what`` (DATA's file, or ``--pca FILE``) unless the model fits
     ``collection``."""
-    from meshvae_lib.input_checks import short_name
-
-    what = short_name(what)
     try:
         model.check_compatible(collection)
     except ValueError as exc:
@@ -87,15 +93,14 @@ def _chosen_meshes(args, model, collection):
     import numpy as np
 
     from meshvae_lib.geometry.collection_io import read_collection
-    from meshvae_lib.input_checks import short_name
     from meshvae_lib.model.evaluation import training_split_of
 
-    data = short_name(args.data)
+    data = _file(args.data)
     V = np.asarray(collection.vertices, dtype=np.float64)
     split = None
     if args.held_out or args.pca == "":
         if args.held_out and model.mesh_digests_ is None:
-            raise UsageError(f"{short_name(args.model)} was written by an older version that did not record which"
+            raise UsageError(f"{_file(args.model)} was written by an older version that did not record which"
                              " meshes it held out: --held-out cannot find them; retrain it")
         try:
             split = training_split_of(model, V)
@@ -107,7 +112,7 @@ def _chosen_meshes(args, model, collection):
         return indices, None
     if args.pca:
         train = read_collection(args.pca, allow_degenerate=args.allow_degenerate)
-        _compatible(model, train, f"--pca {args.pca}")
+        _compatible(model, train, f"--pca {_file(args.pca)}")
         return indices, np.asarray(train.vertices, dtype=np.float64)
     n_train = int((~np.asarray(model.holdout_mask_, dtype=bool)).sum())
     if len(split[0]) != n_train:
@@ -150,7 +155,7 @@ def run(args) -> int:
         inference = GaussNewton(**gn_options)
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
     model = load_model(args.model)
-    _compatible(model, collection, args.data)
+    _compatible(model, collection, _file(args.data))
     if args.fit_latent and args.inference not in (None, "finite-difference"):
         raise UsageError(f"--fit-latent fits by finite differences; it does not combine with --inference {args.inference}")
     indices, V_train = _chosen_meshes(args, model, collection)
