@@ -28,10 +28,11 @@ from meshvae_lib.defaults import FILE_NAME_CHARS
 from meshvae_lib.geometry.collection import MeshCollection, default_names
 from meshvae_lib.geometry.mesh_checks import validate_mesh
 from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
+from meshvae_lib.geometry.npz_files import npz_array, npz_names, open_npz
 from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.input_checks import check_numeric, short_name
 
-__all__ = ["read_collection", "write_collection", "natural_key", "open_npz", "npz_array", "npz_names", "FOLDER_OUTPUTS"]
+__all__ = ["read_collection", "write_collection", "natural_key", "FOLDER_OUTPUTS"]
 
 logger = logging.getLogger(__name__)
 
@@ -240,77 +241,6 @@ def _check_distinct_names(names: list[str], src: str) -> None:
             raise ValueError(f"{src}: mesh name {short_name(repr(name))} is given twice (meshes {first[name]} and {k});"
                              " every mesh needs its own name")
         first[name] = k
-
-
-#: how the files :func:`open_npz` reads begin: a zip archive (an ``.npz``) or a ``.npy`` array.
-_NPZ_MAGIC = (b"PK\x03\x04", b"PK\x05\x06", b"\x93NUMPY")
-
-
-def open_npz(path):
-    """``np.load(path)`` without pickles, with errors that name the file and never advise loading
-    it with pickles (which would run whatever code a foreign file holds).
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    NpzFile (use it as a context manager)
-
-    Raises
-    ------
-    ValueError
-        The file is not an ``.npz`` archive (or is damaged).
-    """
-    path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(6)
-    except OSError:
-        head = _NPZ_MAGIC[0]  # np.load reports it
-    if not head.startswith(_NPZ_MAGIC):  # np.load would take it for a pickle and blame pickled data
-        what = "it is empty" if not head else f"it does not start like one (first bytes {head[:4]!r})"
-        raise ValueError(f"{short_name(path.name)}: cannot be read as .npz: {what}; an .npz is a zip archive"
-                         " of named arrays (numpy.savez)")
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:
-        raise ValueError(f"{short_name(path.name)}: cannot be read as .npz ({_npz_reason(exc)})") from None
-    if not hasattr(data, "files"):  # a plain .npy file under an .npz name
-        raise ValueError(f"{short_name(path.name)}: is a single .npy array, not an .npz archive of named arrays")
-    return data
-
-
-def _npz_reason(exc: BaseException) -> str:
-    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    if "allow_pickle" in text or "pickle" in text.lower():
-        return "it holds Python objects (pickled data), which are never loaded"
-    return short_name(text, 160)
-
-
-def npz_array(data, key: str, path) -> np.ndarray:
-    """Array ``key`` of an open ``.npz`` (:func:`open_npz`), with errors that name the file and the
-    array: an array of Python objects is refused (it would need a pickle), never loaded.
-
-    Returns
-    -------
-    ndarray
-    """
-    try:
-        return np.asarray(data[key])
-    except Exception as exc:  # ValueError: object arrays; zipfile/zlib errors: damaged member
-        raise ValueError(f"{short_name(Path(path).name)}: array {short_name(repr(key))} cannot be read"
-                         f" ({_npz_reason(exc)}); store numbers or text (fixed-width strings)") from None
-
-
-def npz_names(data, key: str, path) -> list[str]:
-    """A 1-D array of names (text or numbers) of an open ``.npz``, as a list of str."""
-    val = npz_array(data, key, path)
-    if val.dtype.kind not in "biuUS" or val.ndim != 1:
-        raise ValueError(f"{short_name(Path(path).name)}: {key!r} must be a 1-D array of text or whole numbers,"
-                         f" got dtype {val.dtype} and shape {val.shape}")
-    return [v.decode(errors="replace") if isinstance(v, bytes) else str(v) for v in val.tolist()]
 
 
 def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshCollection:
