@@ -16,8 +16,10 @@ per-vertex distance (the error of the paper's Table 2), in the mesh's own units.
 mesh's code is the encoder's mean refined by a few Gauss-Newton steps on the vertex error
 (--inference gauss-newton, docs/vae.md "Inference by Gauss-Newton"); --inference encoder is the
 paper's feed-forward encoder alone.
-With --held-out only the meshes held out during training are measured (DATA must then be the
-training collection).
+With --held-out only the meshes held out during training are measured: the model recorded each
+mesh's identity (its vertex positions), so DATA is the training collection in any order (or any
+part of it that holds every held-out mesh); a DATA without them, or with meshes the model was not
+trained on, is refused.
 
 examples:
   meshvae evaluate scape.pt scape.npz
@@ -39,7 +41,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "evaluate", "per-vertex reconstruction error of a model on a collection", DESCRIPTION, run)
     add_model_argument(p)
     p.add_argument("data", metavar="DATA", help="collection (.npz or folder) with the model's mesh")
-    p.add_argument("--held-out", action="store_true", help="only the meshes held out in training")
+    p.add_argument("--held-out", action="store_true",
+                   help="only the meshes held out in training, found in DATA by their vertex positions (any order)")
     p.add_argument("--json", action="store_true",
                    help="print JSON (mean_vertex_error, n_meshes, relative_error, per_mesh, names)")
     p.add_argument("--inference", choices=INFERENCE_METHODS, default=None,
