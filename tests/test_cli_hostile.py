@@ -509,7 +509,8 @@ CASES = [
     Case("interpolate:Ctrl-C while writing", S("interpolate", model, "0", "1", "--data", data, "--steps", "3", "-o",
                                                o("folder")), INT, "interrupted", "folder", "interrupt"),
     Case("interpolate:A a missing mesh file", S("interpolate", model, lambda w, d: d / "a.obj", "1", "--data", data,
-                                                "-o", o("file")), U, "A '/", "file"),
+                                                "-o", o("file")), U,
+         ": no such mesh file; nor is it a mesh name of the collection", "file"),
 ]
 
 
