@@ -83,8 +83,13 @@ def _foreign_entries(path: Path, outputs) -> list[str]:
 
 def _check_replaceable(path: Path, outputs) -> None:
     """ValueError when the existing folder ``path`` holds anything but files of ``outputs`` (it would
-    be replaced as a whole, and those files lost)."""
-    if outputs is None or not path.is_dir():
+    be replaced as a whole, and those files lost), or is the current folder (which cannot be renamed)."""
+    if not path.is_dir():
+        return
+    if path.name in ("", ".", "..") or path.resolve() == Path.cwd().resolve():
+        raise ValueError(f"cannot write {path}: an output folder is replaced as a whole, and this is the current"
+                         " folder (or names no folder of its own): name a new folder")
+    if outputs is None:
         return
     foreign = _foreign_entries(path, outputs)
     if foreign:

@@ -487,6 +487,8 @@ CASES = [
          U, "flipped.pt is corrupted or was edited", "folder"),
     Case("generate:-o a folder holding other files", S("generate", model, "-n", "2", "-o", o("folder")), U,
          "('notes.txt'); an output folder is replaced as a whole", "user folder"),
+    Case("generate:-o the current folder", S("generate", model, "-n", "2", "-o", "."), U,
+         "cannot write .: an output folder is replaced as a whole, and this is the current folder"),
     Case("generate:-o an existing read-only folder (before the work)", S("generate", model, "-o", o("folder")), U,
          "cannot write {d}/old_folder: Permission denied", "folder", "readonly folder"),
     # interpolate
