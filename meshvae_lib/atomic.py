@@ -2,7 +2,8 @@
 
 A file is written to a temporary file in its destination's folder and renamed over the destination
 with ``os.replace`` (:func:`atomic_file`); a folder of files is written to a temporary folder next
-to its destination and renamed into place (:func:`atomic_folder`). When writing fails -- a full
+to its destination and swapped in as a whole (:func:`atomic_folder`): an older folder of that name
+is replaced, never merged with the new files. When writing fails -- a full
 disk, a permission, Ctrl-C -- the temporary output is removed, an older file or folder of that name
 is left as it was (byte for byte), and the error is an :class:`OutputError` (an ``OSError``) that
 names the file: ``cannot write FILE: reason``. :func:`check_writable` says before any work whether a
@@ -67,7 +68,38 @@ def _remove(path: Path) -> None:
             path.unlink()
 
 
-def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path:
+def _is_output(name: str, outputs) -> bool:
+    """Whether a file called ``name`` is one a writer of ``outputs`` writes: an entry starting with a
+    dot is a suffix (".obj"), any other an exact name ("labels.csv")."""
+    lower = name.lower()
+    return any(lower.endswith(o) if o.startswith(".") else lower == o for o in outputs)
+
+
+def _foreign_entries(path: Path, outputs) -> list[str]:
+    """The names in the existing folder ``path`` that are not plain files of ``outputs``, sorted."""
+    return sorted(e.name for e in path.iterdir()
+                  if e.is_symlink() or not e.is_file() or not _is_output(e.name, outputs))
+
+
+def _check_replaceable(path: Path, outputs) -> None:
+    """ValueError when the existing folder ``path`` holds anything but files of ``outputs`` (it would
+    be replaced as a whole, and those files lost), or is the current folder (which cannot be renamed)."""
+    if not path.is_dir():
+        return
+    if path.name in ("", ".", "..") or path.resolve() == Path.cwd().resolve():
+        raise ValueError(f"cannot write {path}: an output folder is replaced as a whole, and this is the current"
+                         " folder (or names no folder of its own): name a new folder")
+    if outputs is None:
+        return
+    foreign = _foreign_entries(path, outputs)
+    if foreign:
+        shown = ", ".join(repr(n) if len(n) <= 60 else repr(n[:57] + "...") for n in foreign[:3])
+        raise ValueError(f"cannot write {path}: it holds {len(foreign)} file(s) or folder(s) that are not outputs"
+                         f" ({shown}{', ...' if len(foreign) > 3 else ''}); an output folder is replaced as a"
+                         " whole: choose a new folder, or empty this one")
+
+
+def check_writable(path, *, folder: bool = False, parents: bool = False, outputs=None) -> Path:
     """Raise ``ValueError`` unless ``path`` can be written (before any work is done for it).
 
     Parameters
@@ -77,10 +109,15 @@ def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path
     folder : bool
         The destination is a folder (it may exist; its temporary folder is made next to it, and
         missing parent folders are created when writing, so the nearest existing ancestor must be
-        a writable folder).
+        a writable folder). An existing folder is replaced as a whole: it must be writable too
+        (its old files are removed).
     parents : bool
         A file whose missing parent folders the writer creates (``write_checkpoint`` does): the
         nearest existing ancestor must then be a writable folder.
+    outputs : sequence of str, optional
+        With ``folder``: what an existing folder may hold (suffixes such as ".obj", or exact names
+        such as "labels.csv", lower case), since replacing it removes everything in it; anything
+        else is refused. None: no check.
 
     Returns
     -------
@@ -90,8 +127,9 @@ def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path
     ------
     ValueError
         The destination is a folder where a file is expected (or a file where a folder is), its
-        folder does not exist (files) or is not a folder, or no file can be created in it (tried
-        with a temporary file, removed at once).
+        folder does not exist (files) or is not a folder, no file can be created in it (tried
+        with a temporary file, removed at once), or an existing output folder holds other files
+        (``outputs``) or cannot be written.
     """
     path = Path(path)
     if folder:
@@ -102,6 +140,9 @@ def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path
             parent = parent.parent
         if not parent.is_dir():
             raise ValueError(f"cannot write {path}: {parent} is not a folder")
+        if path.is_dir():  # replaced as a whole: its old files are removed, so it must be writable
+            _check_replaceable(path, outputs)
+            _probe(path / "out", path)
     else:
         target = path.resolve() if path.is_symlink() else path
         if target.is_dir():
@@ -115,7 +156,13 @@ def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path
             raise ValueError(f"cannot write {path}: folder does not exist: {parent}")
         if not parent.is_dir():
             raise ValueError(f"cannot write {path}: {parent} is not a folder")
-    probe = _temp_name(parent / (path.name or "out"), "probe")
+    _probe(parent / (path.name or "out"), path)
+    return path
+
+
+def _probe(near: Path, path: Path) -> None:
+    """ValueError (naming ``path``) unless a file can be created next to ``near`` (removed at once)."""
+    probe = _temp_name(near, "probe")
     try:
         with open(probe, "wb"):
             pass
@@ -123,7 +170,6 @@ def check_writable(path, *, folder: bool = False, parents: bool = False) -> Path
         raise ValueError(f"cannot write {path}: {_reason(exc)}") from None
     finally:
         _remove(probe)
-    return path
 
 
 @contextlib.contextmanager
@@ -176,19 +222,22 @@ def atomic_file(path, mode: str = "wb", **open_kwargs):
 
 
 @contextlib.contextmanager
-def atomic_folder(path):
-    """A temporary folder next to ``path`` to write files into; on a clean exit they take its place.
+def atomic_folder(path, outputs=None):
+    """A temporary folder next to ``path`` to write files into; on a clean exit it takes ``path``'s place.
 
     When ``path`` does not exist the temporary folder is renamed to it (one step). When it is an
-    existing folder, the new files are renamed into it one by one (renames within one file system
-    need no space): same-named files are replaced, other files in it are left alone. On any
-    exception inside the block the temporary folder is removed and ``path`` is left as it was; an
-    ``OSError`` becomes :class:`OutputError` naming ``path``.
+    existing folder, it is renamed aside, the new folder renamed to ``path`` and the old one removed:
+    the result holds exactly the new files, never a mix of old and new (renames within one file
+    system need no space). On any exception inside the block the temporary folder is removed and
+    ``path`` is left as it was; an ``OSError`` becomes :class:`OutputError` naming ``path``.
 
     Parameters
     ----------
     path : str or Path
         The destination folder; missing parent folders are created.
+    outputs : sequence of str, optional
+        What an existing folder may hold (see :func:`check_writable`); a folder holding anything
+        else raises ValueError before anything is written, so that no other file is removed.
 
     Yields
     ------
@@ -196,24 +245,27 @@ def atomic_folder(path):
         The temporary folder (write the files into it under their final names).
     """
     path = Path(path)
-    tmp = None
+    tmp = aside = None
     try:
         if path.exists() and not path.is_dir():
             raise NotADirectoryError(f"cannot write {path}: it exists and is not a folder")
+        _check_replaceable(path, outputs)
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temp_name(path, "tmp")
         tmp.mkdir()
         yield tmp
-        if not path.exists():
-            os.rename(tmp, path)
-            tmp = None
+        if path.exists():
+            aside = _temp_name(path, "old")
+            os.rename(path, aside)
+            try:
+                os.rename(tmp, path)
+            except BaseException:
+                os.rename(aside, path)
+                aside = None
+                raise
         else:
-            entries = sorted(tmp.iterdir())
-            clash = [e.name for e in entries if (path / e.name).is_dir()]
-            if clash:
-                raise IsADirectoryError(f"cannot write {path / clash[0]}: it is a folder")
-            for entry in entries:
-                os.replace(entry, path / entry.name)
+            os.rename(tmp, path)
+        tmp = None
     except OSError as exc:
         if isinstance(exc, OutputError) and tmp is not None and tmp in exc.path.parents:
             # a file written inside the temporary folder: name it where it was going
@@ -222,5 +274,6 @@ def atomic_folder(path):
             raise
         raise OutputError(path, _reason(exc), exc.errno) from exc
     finally:
-        if tmp is not None:
-            _remove(tmp)
+        for leftover in (tmp, aside):
+            if leftover is not None:
+                _remove(leftover)

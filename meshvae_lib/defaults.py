@@ -168,6 +168,11 @@ MAX_EPOCHS = 1_000_000
 #: the most Gauss-Newton steps per mesh ``meshvae evaluate --fit-latent`` and local/global rounds
 #: ``meshvae reconstruct --iterations`` accept (each step decodes D + 1 meshes or solves once more).
 MAX_SOLVER_STEPS = 1_000
+#: the largest ``meshvae generate --temperature``: draws at 10 prior deviations lie far outside
+#: anything the decoder saw (1e30 would decode to overflowing positions).
+MAX_TEMPERATURE = 10.0
+#: the largest random seed the commands accept (PyTorch's generator takes a signed 64-bit seed).
+MAX_SEED = 2**63 - 1
 #: names (of meshes, files, label values) are cut to this many characters in error messages...
 MESSAGE_NAME_CHARS = 60
 #: ...and a mesh name to this many characters when it becomes part of a file name (file systems

@@ -9,7 +9,7 @@ import pytest
 import torch
 
 from meshvae_lib.geometry.collection import MeshCollection
-from meshvae_lib.model.checkpoint import CHECKPOINT_VERSION
+from meshvae_lib.model.checkpoint import CHECKPOINT_VERSION, _checksum
 from meshvae_lib.model.inference import make_inference
 from meshvae_lib.model.inference.vertex_fit import VertexFit
 from meshvae_lib.model.meshvae_model import FITTED_ATTRIBUTES, MeshVAEModel, load_model
@@ -265,10 +265,19 @@ def test_network_options_round_trip_through_the_checkpoint(collection, tmp_path)
     assert v1.network.sigma_floor == 0.0 and v1.network.output == "tanh"
 
 
+def _format_3(payload: dict) -> dict:
+    """A format-4 payload written back as format 3: no mesh digests, and a checksum of the weights,
+    the reference mesh and the faces instead of the digest of everything."""
+    old = {k: v for k, v in payload.items() if k not in ("digest", "mesh_digests")}
+    kind = payload["kind"]
+    return dict(old, version=3, checksum=_checksum(payload["network_state"], kind["reference"].numpy(),
+                                                   kind["faces"].numpy()))
+
+
 def _old_format(payload: dict, version: int) -> dict:
-    """A format-3 payload written back in the layout of format 1 or 2 (the feature extractor's state,
+    """A format-4 payload written back in the layout of format 1 or 2 (the feature extractor's state,
     no architecture, epochs or selection, ``feature_range`` for a)."""
-    old = dict(payload, version=version)
+    old = dict(_format_3(payload), version=version)
     kind = old.pop("kind")
     old["extractor"] = {"kind": kind["kind"], "layout": kind["options"].get("layout", "paper"),
                         "reference_index": old["estimator"]["reference_index"], "reference": kind["reference"],
@@ -292,7 +301,7 @@ def test_a_loaded_model_has_exactly_the_fitted_attributes_of_a_fitted_one(model,
     assert set(vars(loaded)) == set(vars(model)) | {"last_inference_"}
     assert loaded.train_epochs_ == model.train_epochs_ and loaded.selection_ == model.selection_
     payload = torch.load(tmp_path / "m.pt", weights_only=True)
-    assert payload["version"] == CHECKPOINT_VERSION == 3 and payload["architecture"] == "mesh-vae"
+    assert payload["version"] == CHECKPOINT_VERSION == 4 and payload["architecture"] == "mesh-vae"
 
 
 def test_files_of_format_2_still_load(model, collection, tmp_path):
@@ -304,3 +313,65 @@ def test_files_of_format_2_still_load(model, collection, tmp_path):
     z = model.sample_latent(3, seed=4)
     np.testing.assert_array_equal(v2.decode_latent(z), model.decode_latent(z))
     np.testing.assert_array_equal(v2.encode_meshes(collection), model.encode_meshes(collection))
+
+
+def test_any_edit_of_a_checkpoint_is_refused(model, collection, tmp_path):
+    """The digest covers everything a checkpoint holds: the normaliser scaled by 1.5 and saved again,
+    one bit flipped inside its stored bytes (which torch's zip reader does not check), an edited
+    number of the configuration, a held-out mesh's digest -- each is refused, naming the file."""
+    path = model.save(tmp_path / "m.pt")
+    good = load_model(path)
+    np.testing.assert_array_equal(good.normalizer_.max_, model.normalizer_.max_)
+    edits = {
+        "normaliser": lambda p: p["normalizer"].update(max=p["normalizer"]["max"] * 1.5),
+        "config": lambda p: p["train_config"].update(lr=p["train_config"]["lr"] * 2),
+        "held-out": lambda p: p["holdout_mask"].logical_not_(),
+        "digests": lambda p: p["mesh_digests"].reverse(),
+        "version": lambda p: p.update(version=3),
+    }
+    for name, edit in edits.items():
+        payload = torch.load(path, weights_only=True)
+        edit(payload)
+        torch.save(payload, tmp_path / f"{name}.pt")
+        with pytest.raises(ValueError, match=rf"{name}\.pt is corrupted or was edited"
+                           if name != "version" else rf"{name}\.pt is an incomplete"):
+            load_model(tmp_path / f"{name}.pt")
+    data = bytearray(path.read_bytes())
+    stored = torch.load(path, weights_only=True)["normalizer"]["max"].numpy().tobytes()
+    at = bytes(data).find(stored)
+    assert at > 0 and bytes(data).find(stored, at + 1) < 0  # the normaliser's bytes, stored once
+    data[at + len(stored) // 2] ^= 0x10
+    (tmp_path / "flipped.pt").write_bytes(bytes(data))
+    with pytest.raises(ValueError, match=r"flipped\.pt is corrupted or was edited"):
+        load_model(tmp_path / "flipped.pt")
+
+
+def test_held_out_meshes_are_found_by_identity_in_any_order(model, collection, tmp_path):
+    from meshvae_lib.model.evaluation import evaluate_model, training_split_of
+
+    loaded = load_model(model.save(tmp_path / "m.pt"))
+    held = np.flatnonzero(model.holdout_mask_)
+    base = evaluate_model(loaded, collection, held_out_only=True, inference="encoder")
+    assert base["indices"] == held.tolist()
+    order = np.random.default_rng(3).permutation(len(collection))
+    shuffled = collection.subset(order)
+    res = evaluate_model(loaded, shuffled, held_out_only=True, inference="encoder")
+    assert sorted(order[res["indices"]].tolist()) == held.tolist()
+    assert res["mean_vertex_error"] == pytest.approx(base["mean_vertex_error"], rel=1e-12)
+    train, found = training_split_of(loaded, shuffled.vertices)
+    np.testing.assert_array_equal(np.sort(order[train]), np.flatnonzero(~model.holdout_mask_))
+    np.testing.assert_array_equal(order[found], held)
+    # the held-out meshes alone are enough; other meshes of the same connectivity are refused
+    only_held = collection.subset(held[::-1])
+    assert training_split_of(loaded, only_held.vertices)[0].size == 0
+    other = replace(collection, vertices=collection.vertices * 1.01)
+    with pytest.raises(ValueError, match=f"{held.size} of the model's {held.size} held-out meshes are not"):
+        evaluate_model(loaded, other, held_out_only=True)
+    plus = MeshCollection(np.concatenate([collection.vertices, other.vertices[:1]]), collection.faces)
+    with pytest.raises(ValueError, match=f"1 of this collection's {len(plus)} meshes were not in the model's training"):
+        training_split_of(loaded, plus.vertices)
+    # a file of format 3 has no digests: its held-out meshes are taken by position, as before
+    torch.save(_format_3(torch.load(tmp_path / "m.pt", weights_only=True)), tmp_path / "v3.pt")
+    v3 = load_model(tmp_path / "v3.pt", collection)
+    assert v3.mesh_digests_ is None
+    assert evaluate_model(v3, collection, held_out_only=True, inference="encoder")["indices"] == held.tolist()

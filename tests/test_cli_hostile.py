@@ -1,4 +1,4 @@
-"""Hostile but fair input to every ``meshvae`` command (issue 39), as one table.
+"""Hostile but fair input to every ``meshvae`` command (issues 39 and 50), as one table.
 
 Each row is (case, argv, expected exit status, a fragment of the one-line message, the output the
 command must leave as it was). Rows that write get an old output first -- a file or a folder -- and
@@ -123,7 +123,64 @@ def w(tmp_path_factory):
     ns.damaged_model.write_bytes(model.read_bytes()[:1000])
     ns.a_file = root / "a_file.txt"
     ns.a_file.write_text("not a folder\n")
+    _issue_50_data(ns, root, coll, model)
     return ns
+
+
+def _issue_50_data(ns, root: Path, coll, model: Path) -> None:
+    """The inputs of issue 50: edited checkpoints, a model with held-out meshes and its collection in
+    another order or replaced, over-long names, OFF/PLY files whose header claims what is not there,
+    .npz files without meshes or with a name twice, a name with control characters."""
+    import torch
+
+    from meshvae_lib.model.checkpoint import _checksum
+
+    V, F = coll.vertices, coll.faces
+    payload = torch.load(model, weights_only=True)
+    payload["normalizer"]["max"] = payload["normalizer"]["max"] * 1.5  # scaled, saved again
+    ns.scaled_model = root / "scaled.pt"
+    torch.save(payload, ns.scaled_model)
+    payload = torch.load(model, weights_only=True)
+    payload["network_config"]["input_rank"] = 10**6  # what a message would call input_rank
+    ns.config_model = root / "config.pt"
+    torch.save(payload, ns.config_model)
+    data = bytearray(model.read_bytes())
+    stored = torch.load(model, weights_only=True)["normalizer"]["max"].numpy().tobytes()
+    data[bytes(data).find(stored) + len(stored) // 2] ^= 0x10  # one bit, inside the zip entry (its CRC fails)
+    ns.flipped_model = root / "flipped.pt"
+    ns.flipped_model.write_bytes(bytes(data))
+    ns.held_model = root / "held.pt"
+    assert main(["train", str(ns.data), "-o", str(ns.held_model), "--epochs", "2", "--latent", "2", "--holdout-every", "4",
+                 "--no-progress"]) == 0
+    old = {k: v for k, v in torch.load(ns.held_model, weights_only=True).items() if k not in ("digest", "mesh_digests")}
+    ns.v3_model = root / "v3.pt"  # written before held-out meshes were recorded (format 3)
+    torch.save(dict(old, version=3, checksum=_checksum(old["network_state"], old["kind"]["reference"].numpy(),
+                                                       old["kind"]["faces"].numpy())), ns.v3_model)
+    ns.reversed = write_collection(root / "reversed.npz", coll.subset(np.arange(len(coll))[::-1]))
+    ns.others = write_collection(root / "others.npz", V * 1.01, F, names=coll.names)
+    ns.held_only = write_collection(root / "held_only.npz", coll.subset([7, 3]))
+    ns.plus_one = write_collection(root / "plus_one.npz", np.concatenate([V, V[:1] * 1.01]), F)
+    ns.other_faces = write_collection(root / "other_faces.npz", V, F[:, [0, 2, 1]])
+    ns.long = root / ("y" * 300 + ".npz")  # longer than a file name may be (255 bytes)
+    ns.empty_npz = root / "empty.npz"
+    np.savez(ns.empty_npz, vertices=np.zeros((0, V.shape[1], 3)), faces=F)
+    ns.dup_names = root / "dup_names.npz"
+    np.savez(ns.dup_names, vertices=V, faces=F, names=np.array(["a", "b", "c", "b", "e", "f", "g", "h"]))
+    ns.control = root / "ctrl\x1b[31mred\rname.obj"
+    for name, text in (("off_huge", "OFF\n4 99999999 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n"),
+                       ("off_short", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n")):
+        d = root / name
+        d.mkdir()
+        (d / "m.off").write_text(text)
+        setattr(ns, name, d)
+    write_mesh(root / "whole.ply", V[0], F)
+    ply = (root / "whole.ply").read_bytes()
+    for name, content in (("ply_huge", ply.replace(f"element face {len(F)}".encode(), b"element face 99999999")),
+                          ("ply_short", ply[:-40])):
+        d = root / name
+        d.mkdir()
+        (d / "m.ply").write_bytes(content)
+        setattr(ns, name, d)
 
 
 # --- the table -------------------------------------------------------------------------------
@@ -135,7 +192,8 @@ class Case:
     ``old``), the exit status and a fragment of the message; ``old``: "file" or "folder" when the
     command writes to ``d / OUT`` (an old one is made first and must stay byte-identical);
     ``inject``: "full" (the disk fills midway through a write), "interrupt" (Ctrl-C midway through a
-    write), "interrupt-work" (Ctrl-C during training or evaluation) or "readonly" (no file may be created)."""
+    write), "interrupt-work" (Ctrl-C during training or evaluation), "readonly" (no file may be created)
+    or "readonly folder" (no file may be created in the old output folder, only next to it)."""
 
     id: str
     argv: object
@@ -149,11 +207,15 @@ class Case:
         return self.id.split(":")[0]
 
 
+#: names of the library that a message must not show (the command line names the option instead).
+INTERNAL_NAMES = ("input_rank", "n_features", "holdout_every", "n_components", "latent_dim", "reference_index")
+
+
 def S(*a):  # noqa: N802 - argv builder: strings, and callables of (w, d)
     return lambda w, d: [str(x(w, d)) if callable(x) else str(x) for x in a]
 
 
-OUT = {"file": "old.npz", "folder": "old_folder", "model": "old.pt"}
+OUT = {"file": "old.npz", "folder": "old_folder", "user folder": "old_folder", "model": "old.pt"}
 
 
 def o(kind):
@@ -234,8 +296,8 @@ CASES = [
          "line 3 has an empty mesh name", "file"),
     Case("features:labels.csv empty value", S("features", attr("empty_value"), "-o", o("file")), U,
          "line 3 ('s01') has an empty value in column 'pose'", "file"),
-    Case("features:not an npz", S("features", attr("not_npz"), "-o", o("file")), U, "not.npz: cannot be read as .npz",
-         "file"),
+    Case("features:not an npz", S("features", attr("not_npz"), "-o", o("file")), U,
+         "not.npz: cannot be read as .npz: it does not start like one", "file"),
     Case("features:an npy under an npz name", S("features", attr("npy_as_npz"), "-o", o("file")), U,
          "npy.npz: is a single .npy array", "file"),
     Case("features:-o not .npz", S("features", data, "-o", lambda w, d: d / "feats.txt"), U,
@@ -249,6 +311,28 @@ CASES = [
     Case("features:-o in a read-only folder", S("features", data, "-o", o("file")), U,
          "cannot write {d}/old.npz: Permission denied", "file", "readonly"),
     Case("features:Ctrl-C while writing", S("features", data, "-o", o("file")), INT, "interrupted", "file", "interrupt"),
+    # features: issue 50
+    Case("features:over-long DATA name", S("features", attr("long"), "-o", o("file")), U,
+         "(304 characters): the file name is too long for the file system", "file"),
+    Case("features:over-long -o name", S("features", data, "-o", lambda w, d: d / w.long.name), U,
+         "(304 characters): the file name is too long for the file system"),
+    Case("features:--reference a missing file", S("features", data, "-o", o("file"), "--reference",
+                                                  lambda w, d: d / "rest.obj"), U,
+         ": no such mesh file; nor is it a mesh name of the collection", "file"),
+    Case("features:an .npz without meshes", S("features", attr("empty_npz"), "-o", o("file")), U,
+         "empty.npz: holds no meshes ('vertices' has shape (0, 24, 3))", "file"),
+    Case("features:a mesh name twice in an .npz", S("features", attr("dup_names"), "-o", o("file")), U,
+         "dup_names.npz: mesh name 'b' is given twice (meshes 1 and 3)", "file"),
+    Case("features:OFF header claims 99,999,999 faces", S("features", attr("off_huge"), "-o", o("file")), U,
+         "m.off: its header (line 2) says 4 vertices and 99,999,999 faces, but 6 lines follow it", "file"),
+    Case("features:OFF file cut short", S("features", attr("off_short"), "-o", o("file")), U,
+         "m.off: its header (line 2) says 4 vertices and 2 faces, but 5 lines follow it", "file"),
+    Case("features:PLY header claims 99,999,999 faces", S("features", attr("ply_huge"), "-o", o("file")), U,
+         "m.ply: its header says vertex 24, face 99,999,999 (elements), which need at least", "file"),
+    Case("features:PLY file cut short", S("features", attr("ply_short"), "-o", o("file")), U,
+         "bytes, but the file holds 900: it is cut short or its header is wrong", "file"),
+    Case("features:control characters in a name", S("features", attr("control"), "-o", o("file")), U,
+         "ctrl\\x1b[31mred\\rname.obj", "file"),
     # reconstruct
     Case("reconstruct:missing features", S("reconstruct", lambda w, d: d / "missing.npz", "-o", o("file")), U,
          "no such feature file", "file"),
@@ -275,6 +359,11 @@ CASES = [
          "cannot write {d}/old_folder: Permission denied", "folder", "readonly"),
     Case("reconstruct:Ctrl-C while writing", S("reconstruct", feats, "-o", o("folder")), INT, "interrupted", "folder",
          "interrupt"),
+    Case("reconstruct:-o an existing read-only folder (before the work)", S("reconstruct", feats, "-o", o("folder")), U,
+         "cannot write {d}/old_folder: Permission denied", "folder", "readonly folder"),
+    Case("reconstruct:-o a folder holding other files", S("reconstruct", feats, "-o", o("folder")), U,
+         "it holds 1 file(s) or folder(s) that are not outputs ('notes.txt'); an output folder is replaced as a whole",
+         "user folder"),
     # train
     Case("train:--epochs 0", S("train", data, "-o", o("model"), "--epochs", "0"), U, "--epochs must be >= 1, got 0",
          "file"),
@@ -316,6 +405,14 @@ CASES = [
          "interrupted", "file", "interrupt-work"),
     Case("train:Ctrl-C while writing", S("train", data, "-o", o("model"), "--epochs", "1", "--latent", "2",
                                          "--no-progress"), INT, "interrupted", "file", "interrupt"),
+    Case("train:-o in a missing folder", S("train", data, "-o", lambda w, d: d / "no" / "m.pt"), U,
+         "folder does not exist"),
+    Case("train:--seed 1e20", S("train", data, "-o", o("model"), "--seed", "100000000000000000000"), U,
+         "--seed must be <= 9,223,372,036,854,775,807", "file"),
+    Case("train:spiral network on a small mesh", S("train", data, "-o", o("model"), "--architecture", "spiral",
+                                                   "--epochs", "1", "--no-progress"), U,
+         "too few for its fixed down-sampling by [4, 4, 4, 4] (the coarsest level needs at least 4 faces); use"
+         " --architecture mesh-vae or local-parts", "file"),
     # evaluate (writes nothing)
     Case("evaluate:missing model", S("evaluate", lambda w, d: d / "missing.pt", data), U, "no checkpoint file at"),
     Case("evaluate:damaged model", S("evaluate", attr("damaged_model"), data), U, "damaged"),
@@ -327,6 +424,37 @@ CASES = [
     Case("evaluate:complex coordinates", S("evaluate", model, attr("complex")), U, "got complex numbers"),
     Case("evaluate:labels.csv names a mesh twice", S("evaluate", model, attr("dup_labels")), U, "again"),
     Case("evaluate:Ctrl-C while evaluating", S("evaluate", model, data), INT, "interrupted", None, "interrupt-work"),
+    Case("evaluate:normaliser scaled by 1.5 and saved again", S("evaluate", attr("scaled_model"), data), U,
+         "scaled.pt is corrupted or was edited: what it holds does not match its digest"),
+    Case("evaluate:one bit flipped in the normaliser's bytes", S("evaluate", attr("flipped_model"), data), U,
+         "flipped.pt is corrupted or was edited"),
+    Case("evaluate:network configuration edited", S("evaluate", attr("config_model"), data), U,
+         "config.pt is corrupted or was edited"),
+    Case("evaluate:--held-out on other meshes of the same connectivity", S("evaluate", attr("held_model"),
+                                                                           attr("others"), "--held-out"), U,
+         "--held-out: others.npz: 2 of the model's 2 held-out meshes are not in this collection"),
+    Case("evaluate:--held-out with a mesh that was not trained on", S("evaluate", attr("held_model"),
+                                                                      attr("plus_one"), "--held-out"), U,
+         "1 of this collection's 9 meshes were not in the model's training collection (first: index 8)"),
+    Case("evaluate:--held-out --pca on other meshes", S("evaluate", attr("held_model"), attr("others"), "--held-out",
+                                                        "--pca"), U, "2 of the model's 2 held-out meshes are not in"),
+    Case("evaluate:--pca on the held-out meshes alone", S("evaluate", attr("held_model"), attr("held_only"),
+                                                          "--held-out", "--pca"), U,
+         "--pca: held_only.npz holds 0 of the model's 6 training meshes; PCA must be fitted on all of them"),
+    Case("evaluate:--held-out with a model of format 3", S("evaluate", attr("v3_model"), data, "--held-out"), U,
+         "v3.pt was written by an older version that did not record which meshes it held out"),
+    Case("evaluate:--held-out on a model without held-out meshes", S("evaluate", model, data, "--held-out"), U,
+         "trained without held-out meshes (meshvae train --holdout-every K)"),
+    Case("evaluate:--pca-components more than the training meshes span", S("evaluate", attr("held_model"), data,
+                                                                             "--held-out", "--pca", "--pca-components",
+                                                                             "9"), U,
+         "--pca-components must be <= 5 (what 6 training meshes span), got 9"),
+    Case("evaluate:--pca file with another connectivity", S("evaluate", attr("held_model"), data, "--pca",
+                                                            attr("other_faces")), U,
+         "--pca other_faces.npz: the model was made for another connectivity"),
+    Case("evaluate:over-long model name", S("evaluate", lambda w, d: d / ("m" * 300 + ".pt"), data), U,
+         "(303 characters): the file name is too long for the file system"),
+    Case("evaluate:a mesh name twice in an .npz", S("evaluate", model, attr("dup_names")), U, "is given twice"),
     # generate
     Case("generate:-n 0", S("generate", model, "-n", "0", "-o", o("file")), U, "-n must be >= 1", "file"),
     Case("generate:-n 1e9", S("generate", model, "-n", "1000000000", "-o", o("file")), U,
@@ -350,6 +478,19 @@ CASES = [
          "cannot write {d}/old.npz: Permission denied", "file", "readonly"),
     Case("generate:Ctrl-C while writing", S("generate", model, "-n", "3", "-o", o("folder")), INT, "interrupted",
          "folder", "interrupt"),
+    Case("generate:--temperature 1e30", S("generate", model, "-o", o("file"), "--temperature", "1e30"), U,
+         "--temperature must be <= 10", "file"),
+    Case("generate:--seed -1", S("generate", model, "-o", o("file"), "--seed", "-1"), U, "--seed must be >= 0", "file"),
+    Case("generate:normaliser scaled by 1.5 and saved again", S("generate", attr("scaled_model"), "-o", o("folder")), U,
+         "scaled.pt is corrupted or was edited", "folder"),
+    Case("generate:one bit flipped in the normaliser's bytes", S("generate", attr("flipped_model"), "-o", o("folder")),
+         U, "flipped.pt is corrupted or was edited", "folder"),
+    Case("generate:-o a folder holding other files", S("generate", model, "-n", "2", "-o", o("folder")), U,
+         "('notes.txt'); an output folder is replaced as a whole", "user folder"),
+    Case("generate:-o the current folder", S("generate", model, "-n", "2", "-o", "."), U,
+         "cannot write .: an output folder is replaced as a whole, and this is the current folder"),
+    Case("generate:-o an existing read-only folder (before the work)", S("generate", model, "-o", o("folder")), U,
+         "cannot write {d}/old_folder: Permission denied", "folder", "readonly folder"),
     # interpolate
     Case("interpolate:--steps 1", S("interpolate", model, "0", "1", "--data", data, "--steps", "1", "-o", o("file")), U,
          "--steps must be >= 2", "file"),
@@ -369,6 +510,9 @@ CASES = [
          U, "cannot write {d}/old.npz: Permission denied", "file", "readonly"),
     Case("interpolate:Ctrl-C while writing", S("interpolate", model, "0", "1", "--data", data, "--steps", "3", "-o",
                                                o("folder")), INT, "interrupted", "folder", "interrupt"),
+    Case("interpolate:A a missing mesh file", S("interpolate", model, lambda w, d: d / "a.obj", "1", "--data", data,
+                                                "-o", o("file")), U,
+         ": no such mesh file; nor is it a mesh name of the collection", "file"),
 ]
 
 
@@ -422,9 +566,9 @@ def _inject(monkeypatch, kind: str) -> None:
         monkeypatch.setattr(MeshVAEModel, "fit", interrupted)
         monkeypatch.setattr(evaluation, "evaluate_model", interrupted)
         return
-    if kind == "readonly":  # a folder nobody may write to (as root, chmod would not stop the tests)
+    if kind in ("readonly", "readonly folder"):  # a folder nobody may write to (as root, chmod would not stop the tests)
         def refusing_open(path, mode="r", *args, **kwargs):
-            if "w" in mode:
+            if "w" in mode and (kind == "readonly" or Path(path).parent.name == OUT["folder"]):
                 raise PermissionError(errno.EACCES, "Permission denied", str(path))
             return open(path, mode, *args, **kwargs)
 
@@ -455,10 +599,12 @@ def _make_old(d: Path, kind: str | None, command: str) -> dict | None:
     if kind == "file":
         name = OUT["model"] if command == "train" else OUT["file"]
         (d / name).write_bytes(b"old output " + rng.bytes(2000))
-    else:
+    else:  # "folder": an older output; "user folder": one that holds the user's own file too
         (d / OUT["folder"]).mkdir()
         (d / OUT["folder"] / "0000.obj").write_bytes(b"# old mesh\n" + rng.bytes(500))
-        (d / OUT["folder"] / "notes.txt").write_text("the user's own file\n")
+        (d / OUT["folder"] / "labels.csv").write_text("name,pose\n0000,old\n")
+        if kind == "user folder":
+            (d / OUT["folder"] / "notes.txt").write_text("the user's own file\n")
     return _snapshot(d)
 
 
@@ -488,11 +634,84 @@ def test_hostile_input(w, case, tmp_path, monkeypatch, capsys):
         assert last.startswith(f"meshvae {case.command}: error: "), err
     assert fragment in last, (fragment, last)
     assert "Traceback" not in err and "allow_pickle" not in err and "TrainConfig" not in err, err
+    assert not any(word in last for word in INTERNAL_NAMES), last  # the command line's words, not the library's
+    assert last.isprintable(), repr(last)  # control characters of a name are escaped, not sent to the terminal
     assert len(last) < 600, f"message of {len(last)} characters: {last[:300]}..."
     assert "wrote" not in out
     if before is not None:
         assert _snapshot(d) == before, "the old output changed, or a temporary file was left behind"
     assert not [p for p in d.iterdir() if ".tmp-" in p.name or ".probe-" in p.name]
+
+
+# --- what the issue-50 cases must do when they succeed --------------------------------------------
+
+
+def test_held_out_meshes_are_found_in_any_order_of_the_training_collection(w, capsys):
+    """The training collection in another order gives the model's own held-out error and PCA floor
+    (the meshes are found by their vertex positions, not by their places)."""
+    import json
+
+    runs = []
+    for data in (w.data, w.reversed):
+        capsys.readouterr()
+        assert main(["evaluate", str(w.held_model), str(data), "--held-out", "--pca", "--json", "--no-progress",
+                     "--inference", "encoder"]) == 0
+        runs.append(json.loads(capsys.readouterr().out))
+    same, rev = runs
+    assert same["n_meshes"] == rev["n_meshes"] == 2 and sorted(rev["names"]) == sorted(same["names"]) == ["s03", "s07"]
+    assert rev["indices"] == [4, 0] and same["indices"] == [3, 7]
+    assert rev["mean_vertex_error"] == pytest.approx(same["mean_vertex_error"], rel=1e-12)
+    assert rev["pca"]["mean_vertex_error"] == pytest.approx(same["pca"]["mean_vertex_error"], rel=1e-9, abs=1e-15)
+
+
+def test_a_folder_written_twice_holds_only_the_second_run(w, tmp_path, capsys):
+    out = tmp_path / "d"
+    assert main(["generate", str(w.model), "-n", "5", "-o", str(out)]) == 0
+    assert len(list(out.iterdir())) == 5
+    assert main(["generate", str(w.model), "-n", "2", "-o", str(out)]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["generated_0000.obj", "generated_0001.obj"]
+    assert main(["features", str(out), "-o", str(tmp_path / "f.npz")]) == 0
+    assert "wrote 2 feature vectors" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "f.npz"]  # nothing left aside
+
+
+def test_text_input_a_byte_order_mark_and_names_in_any_script(w, tmp_path, capsys):
+    """labels.csv saved by a spreadsheet as "UTF-8 with BOM" is read; non-ASCII mesh names survive
+    into the names of written files (here numbered, since they do not sort in order)."""
+    d = tmp_path / "bom"
+    d.mkdir()
+    for k in range(2):
+        write_mesh(d / f"s0{k}.obj", w.coll.vertices[k], w.coll.faces)
+    (d / "labels.csv").write_bytes("name,pose\ns00,a\ns01,b\n".encode("utf-8-sig"))
+    assert main(["features", str(d), "-o", str(tmp_path / "bom.npz")]) == 0
+    with np.load(tmp_path / "bom.npz") as f:
+        assert f["label_pose"].tolist() == ["a", "b"]
+    names = ["Zoë_2", "Ästhetik 1", "поза"]
+    src = write_collection(tmp_path / "named.npz", w.coll.vertices[:3], w.coll.faces, names=names)
+    assert main(["features", str(src), "-o", str(tmp_path / "named_feats.npz")]) == 0
+    assert main(["reconstruct", str(tmp_path / "named_feats.npz"), "-o", str(tmp_path / "out")]) == 0
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0000_Zoë_2.obj", "0001_Ästhetik_1.obj",
+                                                                   "0002_поза.obj"]
+
+
+def _cli(*argv, **kwargs):
+    return subprocess.Popen([sys.executable, "-m", "meshvae_lib.cli", *map(str, argv)], cwd=ROOT, text=True,
+                            stderr=subprocess.PIPE, **kwargs)
+
+
+def test_a_closed_pipe_ends_quietly_with_141_and_a_full_stdout_is_an_error(w):
+    """`meshvae evaluate ... --json | head -0`: the reader has gone before the output; the command
+    ends without a word and with the status of a command ended by SIGPIPE. A full stdout (/dev/full)
+    is a failed write: one line, status 1."""
+    proc = _cli("evaluate", w.model, w.data, "--json", "--no-progress", "--inference", "encoder", stdout=subprocess.PIPE)
+    proc.stdout.close()  # long before the command has anything to write
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 141 and err == "", err
+    with open("/dev/full", "w") as full:
+        proc = _cli("synth", "--list", stdout=full)
+        err = proc.stderr.read()
+        assert proc.wait(timeout=120) == EXIT_FAILURE, err
+    assert err.strip() == "meshvae synth: error: cannot write stdout: No space left on device", err
 
 
 # --- cases that used to run for ever ------------------------------------------------------------
@@ -580,16 +799,21 @@ def test_atomic_folder_new_and_existing(tmp_path):
     assert (tmp_path / "new" / "deep" / "a.txt").read_text() == "a"
     old = tmp_path / "old"
     old.mkdir()
-    (old / "keep.txt").write_text("mine")
+    (old / "b.txt").write_text("old b")
     (old / "a.txt").write_text("old a")
     with pytest.raises(RuntimeError):
         with atomic.atomic_folder(old) as tmp:
             (tmp / "a.txt").write_text("new a")
             raise RuntimeError("fails midway")
-    assert (old / "a.txt").read_text() == "old a"
-    with atomic.atomic_folder(old) as tmp:
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt", "b.txt"] and (old / "a.txt").read_text() == "old a"
+    with atomic.atomic_folder(old, outputs=(".txt",)) as tmp:  # replaced as a whole: b.txt is gone
         (tmp / "a.txt").write_text("new a")
-    assert (old / "a.txt").read_text() == "new a" and (old / "keep.txt").read_text() == "mine"
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt"] and (old / "a.txt").read_text() == "new a"
+    (old / "mine.dat").write_text("the user's own file")
+    with pytest.raises(ValueError, match=r"it holds 1 file\(s\) or folder\(s\) that are not outputs \('mine.dat'\)"):
+        with atomic.atomic_folder(old, outputs=(".txt",)) as tmp:
+            (tmp / "a.txt").write_text("newer a")
+    assert sorted(p.name for p in old.iterdir()) == ["a.txt", "mine.dat"] and (old / "a.txt").read_text() == "new a"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
@@ -615,5 +839,7 @@ def test_the_readme_lists_the_bad_inputs_of_the_table():
     for phrase in ("coordinates whose squares overflow", "a face with fewer than three corners",
                    "a face index that names no vertex", "a mesh named twice in `labels.csv`",
                    "complex, text or object arrays", "an `-o` that cannot be written", "`--device`",
-                   "interrupted", "cannot write FILE"):
+                   "interrupted", "cannot write FILE", "corrupted or was edited", "`evaluate --held-out` measures exactly",
+                   "replaces an existing one as a whole", "status 141", "byte-order mark", "a name too long",
+                   "an OFF or PLY header whose counts", "--temperature` is at most 10", "control characters"):
         assert phrase in readme, phrase

@@ -242,7 +242,8 @@ def test_train_a_spiral_network_from_the_command_line(tmp_path, capsys):
     small = write_collection(tmp_path / "small.npz", _strips(n=6))
     assert main(["train", str(small), "-o", str(tmp_path / "y.pt"), "--architecture", "spiral", "--epochs", "1",
                  "--no-progress"]) == 2
-    assert "too few for down-sampling" in capsys.readouterr().err
+    err = capsys.readouterr().err  # the remedy is an option that exists
+    assert "too few for its fixed down-sampling" in err and "use --architecture mesh-vae or local-parts" in err
     # its options are flags (from its Options dataclass) and reach the network
     assert main(["train", str(path), "-o", str(tmp_path / "small.pt"), "--architecture", "spiral", "--epochs", "1",
                  "--latent", "2", "--channels", "8", "4", "--factors", "4", "4", "--spiral-length", "5",

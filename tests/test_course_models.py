@@ -149,12 +149,19 @@ def test_course_model_builds_once_then_loads(cache, monkeypatch):
     np.testing.assert_array_equal(first.holdout_mask_, again.holdout_mask_)
 
 
-@pytest.mark.parametrize("damage", ["truncate", "zeros"])
+@pytest.mark.parametrize("damage", ["truncate", "zeros", "edited"])
 def test_a_damaged_entry_is_rebuilt_not_loaded(cache, caplog, damage):
+    import torch
+
     model = cm.course_model(TINY.name, progress=False)
     path = cm.cache_path(TINY.name)
     data = path.read_bytes()
-    path.write_bytes(data[: len(data) // 2] if damage == "truncate" else bytes(len(data)))
+    if damage == "edited":  # a whole archive whose normaliser was scaled: its digest no longer matches
+        payload = torch.load(path, weights_only=True)
+        payload["normalizer"]["max"] = payload["normalizer"]["max"] * 1.5
+        torch.save(payload, path)
+    else:
+        path.write_bytes(data[: len(data) // 2] if damage == "truncate" else bytes(len(data)))
     with caplog.at_level(logging.WARNING, logger=cm.__name__):
         rebuilt = cm.course_model(TINY.name, progress=False)
     assert "damaged" in caplog.text

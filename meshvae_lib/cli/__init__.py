@@ -17,7 +17,7 @@ torch so that ``--help`` stays fast:
   (:func:`check_budget`, :func:`check_at_most`);
 - the shared arguments (:func:`add_model_argument`, :func:`add_output_argument`,
   :func:`add_allow_degenerate`) and the one resolver of a mesh given on the command line as an
-  index, a mesh name or a file (:func:`resolve_mesh`).
+  index, a mesh name or a file (:func:`resolve_mesh`, in :mod:`~meshvae_lib.cli.mesh_argument`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,6 @@ import importlib
 import logging
 import os
 import sys
-from dataclasses import dataclass
 
 logger = logging.getLogger(__name__)
 
@@ -53,6 +52,9 @@ EXIT_USAGE = 2
 MESSAGE_CHARS = 500
 #: exit status: interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
+#: exit status: stdout was closed by its reader (``meshvae ... | head``): the command ends quietly,
+#: with the status shells report for a command ended by SIGPIPE (128 + 13), as ``cat`` does.
+EXIT_BROKEN_PIPE = 141
 
 EPILOG = """\
 exit status:
@@ -62,8 +64,11 @@ exit status:
      missing or unknown file or mesh name, a damaged checkpoint, a model that does not fit the data,
      an output that cannot be written (all checked before any work)
   130  interrupted (Ctrl-C): nothing half-written is left
+  141  stdout was closed by its reader (`meshvae ... | head`): the command ends quietly, as `cat`
+       does (a full stdout, e.g. /dev/full, is an error: status 1)
 
-outputs are written atomically: a failed write ("cannot write FILE: reason") keeps the old file.
+outputs are written atomically: a failed write ("cannot write FILE: reason") keeps the old file;
+a folder output replaces an existing folder of meshes as a whole (never merged with it).
 
 output: results and "wrote ..." lines go to stdout; progress bars, warnings and errors
 (one line: "meshvae COMMAND: error: ...") go to stderr.
@@ -92,14 +97,33 @@ def exit_status(exc: BaseException) -> int:
     return EXIT_USAGE if isinstance(exc, USAGE_ERRORS) else EXIT_FAILURE
 
 
+def printable(text: str) -> str:
+    """``text`` with control characters (a terminal's escape sequences, carriage returns, a bidi
+    override) written as escapes, ``\\x1b``, so that echoing a name cannot act on the terminal; line
+    breaks and tabs (columns of ``synth --list``) are kept."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c in "\n\t" else repr(c)[1:-1] for c in text)
+
+
 def result(text: str) -> None:
-    """A line of the command's output (results, "wrote ..."): stdout."""
-    print(text, file=sys.stdout)
+    """A line of the command's output (results, "wrote ..."): stdout, flushed at once, so that a
+    full stdout is reported as ``cannot write stdout: reason`` (:class:`~meshvae_lib.atomic.OutputError`,
+    exit status 1) and a reader that has gone (``| head``) ends the command quietly
+    (``BrokenPipeError``, :data:`EXIT_BROKEN_PIPE`)."""
+    try:
+        print(printable(text), file=sys.stdout, flush=True)
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        from meshvae_lib.atomic import OutputError
+
+        raise OutputError("stdout", exc.strerror or str(exc), exc.errno) from None
 
 
 def note(text: str) -> None:
     """A progress or warning line, not part of the output: stderr."""
-    print(text, file=sys.stderr)
+    print(printable(text), file=sys.stderr)
 
 
 # --- shared arguments --------------------------------------------------------------------------
@@ -134,6 +158,15 @@ def check_number(value: float, option: str, *, positive: bool = True) -> None:
         raise UsageError(f"{option} must be a finite number{' > 0' if positive else ''}, got {value}")
 
 
+def check_seed(value: int, option: str = "--seed") -> None:
+    """:class:`UsageError` unless ``value`` is a seed every generator takes: 0 <= value <= ``MAX_SEED``
+    (``defaults``)."""
+    from meshvae_lib.defaults import MAX_SEED
+
+    check_at_least(value, 0, option)
+    check_at_most(value, MAX_SEED, option, "a 64-bit seed")
+
+
 def check_budget(n_meshes: int, n_vertices: int, option: str) -> None:
     """:class:`UsageError` unless ``n_meshes`` meshes of ``n_vertices`` vertices fit in one run's
     budget of ``MAX_OUTPUT_VERTICES`` decoded vertices (``defaults``); the message gives the size,
@@ -152,15 +185,20 @@ def check_budget(n_meshes: int, n_vertices: int, option: str) -> None:
 def check_output(path, *, collection: bool = False, parents: bool = False):
     """The ``-o`` of a command, checked before any work: :class:`UsageError` unless it can be
     written (``meshvae_lib.atomic.check_writable``). ``collection``: an ``.npz`` file when ``path``
-    ends in ``.npz``, else a folder; ``parents``: missing parent folders will be created. Returns
-    the path as a ``Path``."""
+    ends in ``.npz``, else a folder of meshes (an existing one is replaced as a whole, so it must
+    hold only meshes and ``labels.csv``); ``parents``: missing parent folders will be created.
+    Returns the path as a ``Path``."""
     from pathlib import Path
 
     from meshvae_lib.atomic import check_writable
 
     path = Path(path)
+    folder = collection and path.suffix.lower() != ".npz"
+    outputs = None
+    if folder:
+        from meshvae_lib.geometry.collection_io import FOLDER_OUTPUTS as outputs
     try:
-        return check_writable(path, folder=collection and path.suffix.lower() != ".npz", parents=parents)
+        return check_writable(path, folder=folder, parents=parents, outputs=outputs)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 
@@ -182,78 +220,9 @@ def add_allow_degenerate(parser: argparse.ArgumentParser) -> None:
                         help="accept zero-area faces (they get the fallback cotangent weight)")
 
 
-# --- a mesh named on the command line ----------------------------------------------------------
+# --- a mesh named on the command line: meshvae_lib/cli/mesh_argument.py ------------------------
 
-
-@dataclass(frozen=True)
-class ChosenMesh:
-    """A mesh picked by :func:`resolve_mesh`: its vertices (n, 3), its name, and either its index
-    into the collection or the file it was read from."""
-
-    vertices: object
-    name: str
-    index: int | None = None
-    file: str | None = None
-
-    def describe(self) -> str:
-        from meshvae_lib.input_checks import short_name
-
-        return (f"file {self.file}" if self.file is not None
-                else f"mesh {short_name(repr(self.name))} (index {self.index})")
-
-
-def resolve_mesh(spec: str, collection, option: str, *, faces=None, n_vertices: int | None = None,
-                 owner: str = "the collection's", allow_degenerate: bool = False,
-                 hint: str = "") -> ChosenMesh:
-    """The mesh that ``spec`` names: an index into ``collection`` (negative counts from the end), a
-    mesh name of ``collection``, or else a mesh file (OBJ/PLY/OFF). Without a collection only a
-    file.
-
-    option : what the command line calls it (``--reference``, ``A``), for the messages.
-    faces, n_vertices : the connectivity a mesh file must have (default: the collection's);
-        ``owner`` says whose it is in the message ("the collection's", "the model's").
-    hint : appended to the message when ``spec`` names nothing.
-
-    Raises :class:`UsageError` for an index out of range, a ``spec`` that names nothing, or a file
-    with another connectivity.
-    """
-    from meshvae_lib.input_checks import short_name
-
-    if collection is not None:
-        n = len(collection)
-        try:
-            k = int(spec)
-        except ValueError:
-            k = collection.names.index(spec) if spec in collection.names else None
-        if k is not None:
-            if not -n <= k < n:
-                raise UsageError(f"{option} {k} is out of range for {n} meshes (0..{n - 1}, or -{n}..-1"
-                                 " from the end)")
-            k %= n
-            return ChosenMesh(collection.vertices[k], collection.names[k], index=k)
-        if faces is None:
-            faces, n_vertices = collection.faces, collection.n_vertices
-    from pathlib import Path
-
-    path = Path(spec)
-    try:
-        is_file = path.is_file()
-    except (OSError, ValueError):  # a name too long for the file system, a NUL byte
-        is_file = False
-    if not is_file:
-        what = "neither an index, a mesh name of the collection, nor" if collection is not None else "not"
-        raise UsageError(f"{option} {short_name(repr(spec))} is {what} a mesh file{hint}")
-    import numpy as np
-
-    from meshvae_lib.geometry.mesh_files import read_mesh
-
-    V, F = read_mesh(path, allow_degenerate=allow_degenerate)
-    if faces is not None:
-        faces = np.asarray(faces)
-        if len(V) != n_vertices or F.shape != faces.shape or np.any(F != faces):
-            raise UsageError(f"{option} {short_name(path.name)}: its connectivity ({len(V)} vertices, {len(F)} faces)"
-                             f" differs from {owner} ({n_vertices} vertices, {len(faces)} faces)")
-    return ChosenMesh(V, path.stem, file=short_name(path.name))
+from .mesh_argument import ChosenMesh, resolve_mesh  # noqa: E402  (it needs UsageError)
 
 
 # --- the command line --------------------------------------------------------------------------
@@ -297,6 +266,17 @@ def run() -> None:
     except KeyboardInterrupt:  # a second Ctrl-C while the first was being reported
         print("meshvae: interrupted", file=sys.stderr)
         status = EXIT_INTERRUPTED
+    except SystemExit as exc:  # argparse: --help, --version (0), a usage error (2)
+        status = exc.code if isinstance(exc.code, int) else (EXIT_OK if exc.code is None else EXIT_USAGE)
+    try:  # what is left in stdout's buffer (argparse's --help): a reader that has gone ends quietly
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_stdout()
+        status = EXIT_BROKEN_PIPE
+    except OSError as exc:
+        _quiet_stdout()
+        print(f"meshvae: error: cannot write stdout: {exc.strerror or exc}", file=sys.stderr)
+        status = status or EXIT_FAILURE
     if status == EXIT_INTERRUPTED:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         # CPython ends a process by SIGINT (status -2, not 130) whenever a KeyboardInterrupt once escaped
@@ -311,6 +291,36 @@ def run() -> None:
                 pass
         os._exit(status)
     sys.exit(status)
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at the null device, so that the interpreter's last flush at exit finds nothing to
+    complain about (a reader that has gone, a full disk)."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):  # no real file behind stdout (a test's capture)
+        pass
+
+
+def _message(exc: BaseException, command: str) -> tuple[str, int]:
+    """The one-line message and exit status of a command that raised ``exc``."""
+    import errno
+
+    status = exit_status(exc)
+    expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
+    if isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG:  # a name given on the command line
+        from meshvae_lib.input_checks import short_name
+
+        name = exc.filename if exc.filename is not None else ""
+        return f"{short_name(os.path.basename(str(name)) or name)}: the file name is too long for the file system", EXIT_USAGE
+    text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
+    if len(text) > MESSAGE_CHARS:  # a long name or a library's long text: the start and the end
+        text = f"{text[: MESSAGE_CHARS - 200]} ... {text[-150:]}"
+    if not expected:
+        text += f" (run `meshvae -v {command} ...` for the traceback)"
+    return text, status
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -342,17 +352,14 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt:  # Ctrl-C: the writers leave nothing half-written; no traceback
         print(f"meshvae {args.command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # stdout's reader has gone (`| head`): nothing more to say, to anyone
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
     except Exception as exc:  # one line on stderr, no traceback; the status says whose fault it is
-        status = exit_status(exc)
-        expected = isinstance(exc, (*USAGE_ERRORS, CommandFailed, OSError))
-        text = str(exc) if expected and str(exc) else f"{type(exc).__name__}: {exc}"
-        if len(text) > MESSAGE_CHARS:  # a long name or a library's long text: the start and the end
-            text = f"{text[: MESSAGE_CHARS - 200]} ... {text[-150:]}"
-        if not expected:
-            text += f" (run `meshvae -v {args.command} ...` for the traceback)"
+        text, status = _message(exc, args.command)
         if args.verbose:
             logger.error("traceback of the error below", exc_info=exc)
-        print(f"meshvae {args.command}: error: {text}", file=sys.stderr)
+        print(printable(f"meshvae {args.command}: error: {text}").replace("\n", " "), file=sys.stderr)
         return status
 
 

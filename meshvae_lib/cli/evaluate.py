@@ -16,8 +16,10 @@ per-vertex distance (the error of the paper's Table 2), in the mesh's own units.
 mesh's code is the encoder's mean refined by a few Gauss-Newton steps on the vertex error
 (--inference gauss-newton, docs/vae.md "Inference by Gauss-Newton"); --inference encoder is the
 paper's feed-forward encoder alone.
-With --held-out only the meshes held out during training are measured (DATA must then be the
-training collection).
+With --held-out only the meshes held out during training are measured: the model recorded each
+mesh's identity (its vertex positions), so DATA is the training collection in any order (or any
+part of it that holds every held-out mesh); a DATA without them, or with meshes the model was not
+trained on, is refused.
 
 examples:
   meshvae evaluate scape.pt scape.npz
@@ -39,7 +41,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "evaluate", "per-vertex reconstruction error of a model on a collection", DESCRIPTION, run)
     add_model_argument(p)
     p.add_argument("data", metavar="DATA", help="collection (.npz or folder) with the model's mesh")
-    p.add_argument("--held-out", action="store_true", help="only the meshes held out in training")
+    p.add_argument("--held-out", action="store_true",
+                   help="only the meshes held out in training, found in DATA by their vertex positions (any order)")
     p.add_argument("--json", action="store_true",
                    help="print JSON (mean_vertex_error, n_meshes, relative_error, per_mesh, names)")
     p.add_argument("--inference", choices=INFERENCE_METHODS, default=None,
@@ -68,10 +71,65 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+def _file(text: str) -> str:
+    """A file given on the command line as its messages name it: its name, cut to a readable length."""
+    from pathlib import Path
+
+    from meshvae_lib.input_checks import short_name
+
+    return short_name(Path(text).name or text)
+
+
+def _compatible(model, collection, what: str) -> None:
+    """:class:`UsageError` naming ``what`` (DATA's file, or ``--pca FILE``) unless the model fits
+    ``collection``."""
+    try:
+        model.check_compatible(collection)
+    except ValueError as exc:
+        raise UsageError(f"{what}: {exc}") from None
+
+
+def _chosen_meshes(args, model, collection):
+    """The meshes of DATA to measure (indices; with ``--held-out`` the model's held-out meshes, found by
+    their vertex positions in any order) and the training meshes of ``--pca`` ((N, n, 3) float64, or
+    None without ``--pca``); :class:`UsageError` saying why when DATA does not hold them."""
+    import numpy as np
+
+    from meshvae_lib.geometry.collection_io import read_collection
+    from meshvae_lib.model.evaluation import training_split_of
+
+    data = _file(args.data)
+    V = np.asarray(collection.vertices, dtype=np.float64)
+    split = None
+    if args.held_out or args.pca == "":
+        if args.held_out and model.mesh_digests_ is None:
+            raise UsageError(f"{_file(args.model)} was written by an older version that did not record which"
+                             " meshes it held out: --held-out cannot find them; retrain it")
+        try:
+            split = training_split_of(model, V)
+        except ValueError as exc:
+            hint = "" if args.held_out else "; or give the training meshes: --pca TRAIN"
+            raise UsageError(f"{'--held-out' if args.held_out else '--pca'}: {data}: {exc}{hint}") from None
+    indices = split[1] if args.held_out else np.arange(len(collection))
+    if args.pca is None:
+        return indices, None
+    if args.pca:
+        train = read_collection(args.pca, allow_degenerate=args.allow_degenerate)
+        _compatible(model, train, f"--pca {_file(args.pca)}")
+        return indices, np.asarray(train.vertices, dtype=np.float64)
+    n_train = int((~np.asarray(model.holdout_mask_, dtype=bool)).sum())
+    if len(split[0]) != n_train:
+        raise UsageError(f"--pca: {data} holds {len(split[0])} of the model's {n_train} training meshes; PCA must be"
+                         " fitted on all of them: give the training collection as DATA, or the training meshes: --pca TRAIN")
+    return indices, V[split[0]]
+
+
 def run(args) -> int:
     from meshvae_lib.model.meshvae_model import load_model
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.collection_io import read_collection
+
+    import numpy as np
 
     from meshvae_lib.defaults import MAX_SOLVER_STEPS
 
@@ -99,28 +157,28 @@ def run(args) -> int:
 
         inference = GaussNewton(**gn_options)
     collection = read_collection(args.data, allow_degenerate=args.allow_degenerate)
-    model = load_model(args.model, collection)
+    model = load_model(args.model)
+    _compatible(model, collection, _file(args.data))
     if args.fit_latent and args.inference not in (None, "finite-difference"):
         raise UsageError(f"--fit-latent fits by finite differences; it does not combine with --inference {args.inference}")
-    res = evaluate_model(model, collection, held_out_only=args.held_out, fit_iterations=args.fit_latent,
-                         inference=inference, progress=not args.no_progress)
-    if args.pca is not None:
-        import numpy as np
-
+    indices, V_train = _chosen_meshes(args, model, collection)
+    pca = None
+    if V_train is not None:  # the linear floor first: a bad --pca-components is found before the work
         from meshvae_lib.model.evaluation import pca_baseline
 
-        if args.pca:
-            train = read_collection(args.pca, allow_degenerate=args.allow_degenerate)
-            model.check_compatible(train)
-            V_train = np.asarray(train.vertices, dtype=np.float64)
-        else:
-            mask = np.asarray(model.holdout_mask_, dtype=bool)
-            if len(mask) != len(collection) or not mask.any():
-                raise UsageError("--pca without a file needs DATA to be the model's training collection with"
-                                 " held-out meshes; give the training meshes: --pca TRAIN")
-            V_train = np.asarray(collection.vertices, dtype=np.float64)[~mask]
-        V_eval = np.asarray(collection.vertices, dtype=np.float64)[res["indices"]]
-        res["pca"] = pca_baseline(V_train, V_eval, n_components=args.pca_components)
+        V_eval = np.asarray(collection.vertices, dtype=np.float64)[indices]
+        rank = min(len(V_train) - 1, 3 * collection.n_vertices)
+        if args.pca_components is not None and args.pca_components > rank:
+            raise UsageError(f"--pca-components must be <= {rank} (what {len(V_train)} training meshes span),"
+                             f" got {args.pca_components}")
+        try:
+            pca = pca_baseline(V_train, V_eval, n_components=args.pca_components)
+        except ValueError as exc:
+            raise UsageError(str(exc).replace("n_components", "--pca-components")) from None
+    res = evaluate_model(model, collection, indices=indices, fit_iterations=args.fit_latent,
+                         inference=inference, progress=not args.no_progress)
+    if pca is not None:
+        res["pca"] = pca
     if args.json:
         result(json.dumps(res, indent=2))
     else:

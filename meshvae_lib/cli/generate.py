@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from . import (UsageError, add_command, add_model_argument, add_output_argument, check_at_least, check_budget,
-               check_output, result)
+               check_output, check_seed, result)
 
 DESCRIPTION = """\
 Draw N latent vectors from the prior N(0, diag(sigma_object^2)) and decode them into meshes
@@ -37,7 +37,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="label value for a conditional model (repeatable)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
     p.add_argument("--temperature", type=float, default=1.0, metavar="T",
-                   help="scale of the prior's deviations (default 1: the paper's prior; lower: nearer the training poses)")
+                   help="scale of the prior's deviations, > 0 and <= 10 (default 1: the paper's prior; lower: nearer"
+                        " the training poses)")
     return p
 
 
@@ -48,11 +49,17 @@ def run(args) -> int:
     from meshvae_lib.geometry.collection_io import write_collection
     from meshvae_lib.validation import check_positive
 
+    from meshvae_lib.defaults import MAX_TEMPERATURE
+
     check_at_least(args.n, 1, "-n")
     try:
         check_positive(args.temperature, "--temperature")
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    if args.temperature > MAX_TEMPERATURE:
+        raise UsageError(f"--temperature must be <= {MAX_TEMPERATURE:g} (draws at more prior deviations are far outside"
+                         f" what the model learned), got {args.temperature:g}")
+    check_seed(args.seed)
     check_output(args.output, collection=True)
     model = load_model(args.model)
     check_budget(args.n, len(model.reference_vertices), "-n")

@@ -12,7 +12,7 @@ from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOC
 from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
 from . import (CommandFailed, UsageError, add_allow_degenerate, add_command, add_output_argument, check_at_least,
-               check_at_most, check_number, check_output, note, result)
+               check_at_most, check_number, check_output, check_seed, note, result)
 
 logger = logging.getLogger(__name__)
 
@@ -63,6 +63,20 @@ def _option_names(text: str, flags: dict | None = None) -> str:
     return re.sub(r"\b(" + "|".join(map(re.escape, words)) + r")\b",
                   lambda m: {"holdout_every": "--holdout-every", "reference_index": "--reference"}.get(
                       m.group(1), names.get(m.group(1), m.group(1))), text)
+
+
+def _small_mesh(text: str, args, collection) -> str:
+    """A network's complaint that the mesh is too small to down-sample, in the command line's words:
+    the spiral network's down-sampling is fixed (SpiralNet++'s settings), so the remedy is another
+    ``--architecture``."""
+    if "down-sampl" not in text:
+        return text
+    from meshvae_lib.model.networks import ARCHITECTURE_NAMES
+
+    others = " or ".join(a for a in ARCHITECTURE_NAMES if a != args.architecture)
+    return (f"--architecture {args.architecture}: the mesh has {collection.n_vertices} vertices ({len(collection.faces)}"
+            f" faces), too few for its fixed {text.split('too few for ', 1)[-1].split(';')[0]};"
+            f" use --architecture {others}")
 
 
 def _check_device(text: str) -> None:
@@ -252,9 +266,9 @@ def run(args) -> int:
         check_at_least(h, 1, "--hidden")
     if args.holdout_every != 0:
         check_at_least(args.holdout_every, 2, "--holdout-every", "or 0 for none")
-    check_at_least(args.seed, 0, "--seed")
+    check_seed(args.seed)
     _check_device(args.device)
-    check_output(args.output, parents=True)  # model.save creates missing folders
+    check_output(args.output)  # its folder must exist, as for every command's -o
     network = network_class(args.architecture)
     hidden = _network_choices(args, network)
     options, flags = _network_options(args, network)
@@ -287,7 +301,7 @@ def run(args) -> int:
     except TrainingDiverged as exc:  # valid input, failed training: not the command's fault
         raise CommandFailed(str(exc)) from exc
     except ValueError as exc:
-        raise UsageError(_option_names(str(exc), flags)) from exc
+        raise UsageError(_small_mesh(_option_names(str(exc), flags), args, collection)) from exc
     model.save(args.output)
     last = model.history_[-1]
     if model.selection_ is not None and "skipped" in model.selection_:

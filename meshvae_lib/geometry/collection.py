@@ -13,7 +13,7 @@ import numpy as np
 
 from meshvae_lib.validation import check_faces, check_vertices
 
-__all__ = ["MeshCollection", "default_names"]
+__all__ = ["MeshCollection", "default_names", "mesh_digests", "find_meshes"]
 
 
 @dataclass
@@ -84,3 +84,35 @@ def default_names(n: int) -> list[str]:
     so that they sort in order)."""
     width = max(4, len(str(max(n - 1, 0))))
     return [f"{k:0{width}d}" for k in range(n)]
+
+
+def mesh_digests(vertices) -> list[str]:
+    """The identity of each mesh: a digest (blake2b, 32 hex digits) of its vertex positions as
+    float64 bytes, so that a mesh read back from an ``.npz``, an OBJ, OFF or PLY file (all of which
+    keep float64 positions exactly) is recognised whatever its name or place in a collection.
+
+    vertices : (n_meshes, n_vertices, 3) float. Returns a list of n_meshes str.
+    """
+    import hashlib
+
+    V = np.ascontiguousarray(check_vertices(vertices, "vertices", batch=True), dtype="<f8")
+    return [hashlib.blake2b(V[k].tobytes(), digest_size=16).hexdigest() for k in range(len(V))]
+
+
+def find_meshes(digests, vertices) -> tuple[np.ndarray, np.ndarray]:
+    """Where the meshes with ``digests`` (:func:`mesh_digests`) are among ``vertices``.
+
+    digests : list of str (a digest may repeat: as many equal meshes are then looked for).
+    vertices : (n_meshes, n_vertices, 3) float.
+
+    Returns ``(found, missing)``: ``found`` (k,) int64, for each digest found the index of its mesh
+    in ``vertices`` (each index used once, in the order of ``digests``); ``missing`` (m,) int64, the
+    positions in ``digests`` of those not found.
+    """
+    places: dict[str, list[int]] = {}
+    for k, d in enumerate(mesh_digests(vertices)):
+        places.setdefault(d, []).append(k)
+    found, missing = [], []
+    for j, d in enumerate(digests):
+        (found.append(places[d].pop(0)) if places.get(d) else missing.append(j))
+    return np.asarray(found, dtype=np.int64), np.asarray(missing, dtype=np.int64)

@@ -28,12 +28,18 @@ from meshvae_lib.defaults import FILE_NAME_CHARS
 from meshvae_lib.geometry.collection import MeshCollection, default_names
 from meshvae_lib.geometry.mesh_checks import validate_mesh
 from meshvae_lib.geometry.mesh_files import MESH_SUFFIXES, read_mesh, write_mesh
+from meshvae_lib.geometry.npz_files import npz_array, npz_names, open_npz
 from meshvae_lib.progress import progress as progress_bar
 from meshvae_lib.input_checks import check_numeric, short_name
 
-__all__ = ["read_collection", "write_collection", "natural_key", "open_npz", "npz_array", "npz_names"]
+__all__ = ["read_collection", "write_collection", "natural_key", "FOLDER_OUTPUTS"]
 
 logger = logging.getLogger(__name__)
+
+#: what a collection folder that :func:`write_collection` replaces may hold: mesh files and
+#: ``labels.csv`` (``meshvae_lib.atomic.check_writable``'s ``outputs``); a folder holding anything
+#: else is refused rather than replaced.
+FOLDER_OUTPUTS = (*MESH_SUFFIXES, "labels.csv")
 
 
 def natural_key(name: str) -> list:
@@ -61,12 +67,13 @@ def _names(names) -> str:
 def _read_labels_csv(path: Path, names: list[str]) -> dict[str, np.ndarray]:
     """The label columns of a folder's ``labels.csv``: one row per mesh, in ``names``' order.
 
-    Raises ``ValueError`` naming the file and the line for a header without ``name`` first, an
+    The file is UTF-8, with or without a byte-order mark. Raises ``ValueError`` naming the file and
+    the line for a header without ``name`` first, an
     empty row (blank lines at the end are allowed), a row with another number of fields, an empty
     mesh name or label value, a mesh named twice, and rows missing or naming no mesh.
     """
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark (Excel's UTF-8 CSV) is skipped
             rows = list(enumerate(csv.reader(fh), start=1))
     except (UnicodeDecodeError, csv.Error) as exc:
         raise ValueError(f"{path}: is not a readable CSV file ({short_name(exc, 120)})") from None
@@ -205,9 +212,12 @@ def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
                 f"{src}: 'faces' must be triangles with shape (F, 3), got {faces.shape}"
             )
         n = len(vertices)
+        if n == 0:
+            raise ValueError(f"{src}: holds no meshes ('vertices' has shape {vertices.shape})")
         names = (npz_names(data, "names", path) if "names" in data.files else default_names(n))
         if len(names) != n:
             raise ValueError(f"{src}: {len(names)} names for {n} meshes")
+        _check_distinct_names(names, src)
         labels = {}
         for key in data.files:
             if key.startswith("label_"):
@@ -223,62 +233,14 @@ def _read_npz(path: Path, allow_degenerate: bool) -> MeshCollection:
     return MeshCollection(vertices, faces.astype(np.int64), names, labels)
 
 
-def open_npz(path):
-    """``np.load(path)`` without pickles, with errors that name the file and never advise loading
-    it with pickles (which would run whatever code a foreign file holds).
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    NpzFile (use it as a context manager)
-
-    Raises
-    ------
-    ValueError
-        The file is not an ``.npz`` archive (or is damaged).
-    """
-    path = Path(path)
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:
-        raise ValueError(f"{short_name(path.name)}: cannot be read as .npz ({_npz_reason(exc)})") from None
-    if not hasattr(data, "files"):  # a plain .npy file under an .npz name
-        raise ValueError(f"{short_name(path.name)}: is a single .npy array, not an .npz archive of named arrays")
-    return data
-
-
-def _npz_reason(exc: BaseException) -> str:
-    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    if "allow_pickle" in text or "pickle" in text.lower():
-        return "it holds Python objects (pickled data), which are never loaded"
-    return short_name(text, 160)
-
-
-def npz_array(data, key: str, path) -> np.ndarray:
-    """Array ``key`` of an open ``.npz`` (:func:`open_npz`), with errors that name the file and the
-    array: an array of Python objects is refused (it would need a pickle), never loaded.
-
-    Returns
-    -------
-    ndarray
-    """
-    try:
-        return np.asarray(data[key])
-    except Exception as exc:  # ValueError: object arrays; zipfile/zlib errors: damaged member
-        raise ValueError(f"{short_name(Path(path).name)}: array {short_name(repr(key))} cannot be read"
-                         f" ({_npz_reason(exc)}); store numbers or text (fixed-width strings)") from None
-
-
-def npz_names(data, key: str, path) -> list[str]:
-    """A 1-D array of names (text or numbers) of an open ``.npz``, as a list of str."""
-    val = npz_array(data, key, path)
-    if val.dtype.kind not in "biuUS" or val.ndim != 1:
-        raise ValueError(f"{short_name(Path(path).name)}: {key!r} must be a 1-D array of text or whole numbers,"
-                         f" got dtype {val.dtype} and shape {val.shape}")
-    return [v.decode(errors="replace") if isinstance(v, bytes) else str(v) for v in val.tolist()]
+def _check_distinct_names(names: list[str], src: str) -> None:
+    """ValueError naming the first mesh name that ``names`` holds twice (a name must pick one mesh)."""
+    first: dict[str, int] = {}
+    for k, name in enumerate(names):
+        if name in first:
+            raise ValueError(f"{src}: mesh name {short_name(repr(name))} is given twice (meshes {first[name]} and {k});"
+                             " every mesh needs its own name")
+        first[name] = k
 
 
 def _read_folder(path: Path, allow_degenerate: bool, progress: bool) -> MeshCollection:
@@ -321,8 +283,9 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
     float64 precision in both formats.
 
     Writing is atomic (:mod:`meshvae_lib.atomic`): the ``.npz`` through a temporary file, the folder
-    through a temporary folder whose files then take their places (other files in an existing
-    folder are left alone). A failed write leaves the old output as it was and raises
+    through a temporary folder that replaces an existing folder as a whole (so it holds exactly the
+    new meshes; a folder holding files other than :data:`FOLDER_OUTPUTS` raises ValueError and is
+    left alone). A failed write leaves the old output as it was and raises
     :class:`~meshvae_lib.atomic.OutputError` (``cannot write FILE: reason``).
 
     Parameters
@@ -359,14 +322,12 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
             np.savez_compressed(fh, **arrays)
         return path
     stems = list(col.names)
-    safe = (all(re.fullmatch(r"[\w.+-]+", s) and len(s) <= FILE_NAME_CHARS for s in stems)
+    safe = (all(_FILE_NAME.fullmatch(s) and len(s.encode()) <= FILE_NAME_CHARS for s in stems)
             and len(set(stems)) == len(stems))
     if not safe or sorted(stems, key=natural_key) != stems:
         width = max(4, len(str(len(stems) - 1)))
-        stems = [
-            f"{k:0{width}d}_{re.sub(r'[^0-9A-Za-z.+-]+', '_', s)[:FILE_NAME_CHARS]}" for k, s in enumerate(stems)
-        ]
-    with atomic_folder(path) as tmp:
+        stems = [f"{k:0{width}d}_{_file_name_part(s)}" for k, s in enumerate(stems)]
+    with atomic_folder(path, outputs=FOLDER_OUTPUTS) as tmp:
         for V, stem in zip(col.vertices, stems):
             write_mesh(tmp / f"{stem}.obj", V, col.faces)
         if col.labels:
@@ -377,6 +338,18 @@ def write_collection(path, vertices, faces=None, names=None, labels=None) -> Pat
                 for k, stem in enumerate(stems):
                     w.writerow([stem, *[_fmt_label(col.labels[c][k]) for c in keys]])
     return path
+
+
+#: a mesh name usable as a file name as it is: letters and digits of any script, ``_ . + -``.
+_FILE_NAME = re.compile(r"[\w.+-]+")
+
+
+def _file_name_part(name: str) -> str:
+    """``name`` made usable in a file name: runs of other characters (spaces, slashes, control
+    characters) become ``_``, letters of any script are kept, cut to ``FILE_NAME_CHARS`` bytes of
+    UTF-8 (file systems count bytes)."""
+    text = re.sub(r"[^\w.+-]+", "_", name).encode()[:FILE_NAME_CHARS]
+    return text.decode(errors="ignore")
 
 
 def _fmt_label(v) -> str:

@@ -107,6 +107,9 @@ def _check_off_faces(text: str, name: str) -> int:
         nv, nf = int(counts[0]), int(counts[1])
     except (ValueError, IndexError):
         return 3
+    if nv < 0 or nf < 0 or len(lines) - start < nv + nf:
+        raise ValueError(f"{name}: its header (line {lines[start - 1][0]}) says {nv:,} vertices and {nf:,} faces,"
+                         f" but {len(lines) - start:,} lines follow it: the file is cut short or its header is wrong")
     for lineno, ln in lines[start + nv : start + nv + nf]:
         try:
             n = int(ln[0])
@@ -123,6 +126,61 @@ def _check_off_faces(text: str, name: str) -> int:
                              f" from 0; the file has {nv} vertices)")
         most = max(most, n)
     return most
+
+
+#: bytes of each PLY property type.
+_PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
+              "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}
+
+
+def _ply_counts(path: Path, name: str) -> dict[str, int]:
+    """The element counts a PLY file's header states (``{"vertex": n, "face": m, ...}``), checked
+    against the data that follows: an ASCII file needs a line per element, a binary file at least the
+    bytes of its fixed-size properties (and of a triangle per face). Raises ``ValueError`` naming the
+    file for a header that claims more than the file holds (cut short, or a wrong header), so that no
+    reader allocates for counts that are not there. Returns {} when the header cannot be parsed (the
+    reader then reports it)."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    end = head.find(b"end_header")
+    if not head.startswith(b"ply") or end < 0:
+        return {}
+    body_start = head.find(b"\n", end) + 1
+    fmt, elements = "", []  # (name, count, [(kind, sizes)])
+    for line in head[:end].decode("ascii", errors="replace").splitlines():
+        words = line.split()
+        if not words:
+            continue
+        try:
+            if words[0] == "format":
+                fmt = words[1]
+            elif words[0] == "element":
+                elements.append((words[1], int(words[2]), []))
+            elif words[0] == "property" and elements:
+                if words[1] == "list":
+                    elements[-1][2].append(("list", _PLY_SIZES.get(words[2], 1), _PLY_SIZES.get(words[3], 1)))
+                else:
+                    elements[-1][2].append(("scalar", _PLY_SIZES.get(words[1], 1), 0))
+        except (IndexError, ValueError):
+            return {}
+    size = path.stat().st_size - body_start
+    if fmt == "ascii":
+        with open(path, "rb") as fh:
+            fh.seek(body_start)
+            available = sum(1 for ln in fh if ln.strip())
+        needed = sum(count for _, count, _ in elements)
+        unit = "lines"
+    else:
+        needed = 0
+        for element, count, props in elements:
+            per = sum(a + (3 * b if element == "face" else 0) for _, a, b in props)
+            needed += count * per
+        available, unit = size, "bytes"
+    if any(count < 0 for _, count, _ in elements) or available < needed:
+        stated = ", ".join(f"{element} {count:,}" for element, count, _ in elements)
+        raise ValueError(f"{name}: its header says {stated} (elements), which need at least {needed:,} {unit}, but the file"
+                         f" holds {available:,}: it is cut short or its header is wrong")
+    return {element: count for element, count, _ in elements}
 
 
 def read_mesh(
@@ -165,6 +223,7 @@ def read_mesh(
                 f"{short_name(path.name)}: has faces with {corners} corners; only triangle meshes are "
                 "supported (triangulate it, or read it with triangulate=True)"
             )
+    stated = _ply_counts(path, short_name(path.name)) if path.suffix.lower() == ".ply" else {}
     try:
         mesh = trimesh.load(path, process=False, maintain_order=True, force="mesh")
     except Exception as exc:  # trimesh raises many kinds of errors for unreadable files
@@ -173,6 +232,10 @@ def read_mesh(
     F = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
     if F.size == 0:
         raise ValueError(f"{short_name(path.name)}: holds no triangles")
+    for what, got in (("vertex", len(V)), ("face", len(F))):
+        if what in stated and stated[what] != got:
+            raise ValueError(f"{short_name(path.name)}: its header says {stated[what]:,} {what} elements, {got:,} were"
+                             " read: the file is damaged or its header is wrong")
     if validate:
         validate_mesh(V, F, name=short_name(path.name), allow_degenerate=allow_degenerate)
     return V, F

@@ -16,7 +16,7 @@ import numpy as np
 
 from meshvae_lib.atomic import atomic_file
 from meshvae_lib.defaults import DEFAULT_LAYOUT, LAYOUTS
-from meshvae_lib.geometry.collection_io import npz_array, npz_names, open_npz
+from meshvae_lib.geometry.npz_files import npz_array, npz_names, open_npz
 from meshvae_lib.geometry.rimd import RIMDLayout
 from meshvae_lib.input_checks import check_numeric, short_name
 from meshvae_lib.validation import check_faces, check_finite, check_rows, check_vertices

@@ -4,9 +4,12 @@
 (:meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.state_dict`), :func:`read_checkpoint` reads it
 back (``meshvae_model.load_model`` builds the model from it). A checkpoint is one file written with
 ``torch.save`` that holds only tensors, numbers, strings, lists and dicts (it loads with
-``weights_only=True``: no code runs when reading it), plus a checksum of the weights and the
-reference mesh, so that a corrupted, truncated or foreign file gives a clear error instead of a
-broken model. Files of formats 1 and 2 are read too (:func:`read_checkpoint` upgrades them).
+``weights_only=True``: no code runs when reading it), plus a digest of everything else it holds
+(:func:`payload_digest`: the weights, the normaliser, the reference mesh, the configuration, the
+held-out meshes' digests, the history), so that a corrupted, truncated, edited or foreign file
+gives a clear error instead of a broken model. Files of formats 1 to 3 are read too
+(:func:`read_checkpoint` upgrades them); their checksum covers only the weights, the reference mesh
+and the faces.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ import torch
 
 from meshvae_lib.atomic import atomic_file
 
-__all__ = ["write_checkpoint", "read_checkpoint", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
+__all__ = ["write_checkpoint", "read_checkpoint", "payload_digest", "CHECKPOINT_FORMAT", "CHECKPOINT_VERSION"]
 
 logger = logging.getLogger(__name__)
 
@@ -31,8 +34,10 @@ logger = logging.getLogger(__name__)
 CHECKPOINT_FORMAT = "meshvae-checkpoint"
 #: bumped when the layout of the checkpoint changes (2: the network config has ``sigma_floor`` and ``output``;
 #: version 1 files load with their defaults, 0 and "tanh"; 3: the network's ``architecture``, the feature
-#: kind's state instead of the feature extractor's, the epochs trained and early stopping's record).
-CHECKPOINT_VERSION = 3
+#: kind's state instead of the feature extractor's, the epochs trained and early stopping's record;
+#: 4: a ``digest`` of everything stored instead of a ``checksum`` of the weights and the reference
+#: mesh, and the digest of every training mesh, ``mesh_digests``).
+CHECKPOINT_VERSION = 4
 
 
 def _to_storable(obj):
@@ -69,6 +74,47 @@ def _checksum(state_dict: dict, reference: np.ndarray, faces: np.ndarray) -> str
     return h.hexdigest()
 
 
+def _update_digest(h, obj) -> None:
+    """Feed ``obj`` (what a checkpoint stores: tensors, dicts, lists, strings, numbers, None) to the
+    hash ``h`` in one unambiguous byte form: each value is tagged with its type and its length."""
+
+    def put(tag: bytes, data: bytes) -> None:
+        h.update(tag + len(data).to_bytes(8, "little") + data)
+
+    if isinstance(obj, torch.Tensor):
+        t = obj.detach().cpu().contiguous()
+        put(b"T", f"{t.dtype}{tuple(t.shape)}".encode())
+        put(b"B", t.reshape(-1).view(torch.uint8).numpy().tobytes())
+    elif isinstance(obj, dict):
+        put(b"D", str(len(obj)).encode())
+        for key in sorted(obj, key=repr):
+            _update_digest(h, key)
+            _update_digest(h, obj[key])
+    elif isinstance(obj, (list, tuple)):
+        put(b"L", str(len(obj)).encode())
+        for item in obj:
+            _update_digest(h, item)
+    elif isinstance(obj, str):
+        put(b"S", obj.encode("utf-8", "surrogatepass"))
+    elif obj is None or isinstance(obj, bool):
+        put(b"N" if obj is None else b"b", str(obj).encode())
+    elif isinstance(obj, int):
+        put(b"I", str(obj).encode())
+    elif isinstance(obj, float):
+        put(b"F", obj.hex().encode())
+    else:
+        raise TypeError(f"a checkpoint stores no {type(obj).__name__}")
+
+
+def payload_digest(payload: dict) -> str:
+    """The digest (blake2b, 32 hex digits) of a checkpoint's payload, every entry but ``digest``
+    itself: the stored tensors' dtypes, shapes and bytes, and every string, number, list and dict.
+    Any change to what a checkpoint holds changes it."""
+    h = hashlib.blake2b(digest_size=16)
+    _update_digest(h, {k: v for k, v in payload.items() if k != "digest"})
+    return h.hexdigest()
+
+
 def write_checkpoint(path, state: dict) -> Path:
     """Write a model's ``state`` (:meth:`~meshvae_lib.model.meshvae_model.MeshVAEModel.state_dict`) to
     ``path`` as one checkpoint file (what ``model.save(path)`` does). Returns the path.
@@ -87,8 +133,8 @@ def write_checkpoint(path, state: dict) -> Path:
         "torch_version": str(torch.__version__),
         **{k: _to_storable(v) for k, v in state.items() if k != "network_state"},
         "network_state": network_state,
-        "checksum": _checksum(network_state, state["kind"]["reference"], state["kind"]["faces"]),
     }
+    payload["digest"] = payload_digest(payload)
     buffer = io.BytesIO()  # serialised first: torch reports a failed write as a RuntimeError, not an OSError
     torch.save(payload, buffer)
     with atomic_file(path) as fh:
@@ -124,7 +170,8 @@ def read_checkpoint(path) -> dict:
     :func:`~meshvae_lib.model.meshvae_model.load_model`, which does both).
 
     Raises FileNotFoundError for a missing file and ValueError for a file that is not a mesh VAE
-    checkpoint, is corrupted or truncated, or was written by a newer version.
+    checkpoint, is corrupted, truncated or edited (its content does not match its digest), or was
+    written by a newer version.
     """
     path = Path(path)
     if not path.is_file():
@@ -151,13 +198,19 @@ def read_checkpoint(path) -> dict:
         raise ValueError(f"{path} was written by a newer version (checkpoint format {payload['version']},"
                          f" this library reads up to {CHECKPOINT_VERSION})")
     try:
+        version = int(payload["version"])
+        if version >= 4 and payload_digest(payload) != payload["digest"]:
+            raise ValueError(f"{path} is corrupted or was edited: what it holds does not match its digest"
+                             " (retrain, or use an unedited copy)")
         state = {k: (v if k == "network_state" else _to_numpy(v)) for k, v in payload.items()
-                 if k not in ("format", "version", "torch_version", "checksum")}
-        if int(payload["version"]) < 3:
+                 if k not in ("format", "version", "torch_version", "checksum", "digest")}
+        if version < 3:
             state = _upgrade(state)
-        kind = state["kind"]
-        if _checksum(state["network_state"], kind["reference"], kind["faces"]) != payload["checksum"]:
-            raise ValueError(f"{path} is corrupted: its weights do not match the stored checksum")
+        if version < 4:
+            kind = state["kind"]
+            if _checksum(state["network_state"], kind["reference"], kind["faces"]) != payload["checksum"]:
+                raise ValueError(f"{path} is corrupted: its weights do not match the stored checksum")
+            state.setdefault("mesh_digests", None)
     except (KeyError, TypeError, RuntimeError, AttributeError) as exc:
         raise ValueError(f"{path} is an incomplete or inconsistent mesh VAE checkpoint: {exc!r}") from exc
     return state

@@ -18,7 +18,7 @@ from meshvae_lib.model.inference import make_inference
 from meshvae_lib.tolerances import PCA_RANK_RTOL
 from meshvae_lib.validation import check_is_fitted, check_vertices
 
-__all__ = ["per_vertex_error", "evaluate_model", "CoordinatePCA", "pca_baseline", "regional_pca_baseline"]
+__all__ = ["per_vertex_error", "evaluate_model", "training_split_of", "CoordinatePCA", "pca_baseline", "regional_pca_baseline"]
 
 
 def per_vertex_error(V_pred, V_true, align: bool = True) -> np.ndarray:
@@ -43,8 +43,9 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
 
     model : :class:`~meshvae_lib.model.meshvae_model.MeshVAEModel`.
     collection : MeshCollection-like with ``vertices (N, n, 3)``, ``faces``, ``labels``, ``names``.
-    indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes (the
-        collection must then be the one it was trained on).
+    indices : which meshes (default: all); ``held_out_only`` uses the model's held-out meshes,
+        found by their identity (:func:`training_split_of`): the collection must hold all of them,
+        in any order, and no mesh that was not in the training collection.
     inference : None (the model's own inference: by default "gauss-newton", the encoder's mean
         refined on the vertex error), a name of :data:`~meshvae_lib.model.inference.METHODS`
         ("encoder": the paper's feed-forward encoder) or a strategy object.
@@ -61,7 +62,7 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
     """
     model.check_compatible(collection)
     V = np.asarray(collection.vertices, dtype=np.float64)
-    idx = _evaluated(model, len(V), indices, held_out_only)
+    idx = _evaluated(model, len(V), indices, held_out_only, V)
     labels = {k: np.asarray(v)[idx] for k, v in (getattr(collection, "labels", {}) or {}).items()}
     sub = V[idx]
     if fit_iterations:
@@ -92,16 +93,53 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
     }
 
 
-def _evaluated(model, n: int, indices, held_out_only: bool) -> np.ndarray:
+def training_split_of(model, vertices) -> tuple[np.ndarray, np.ndarray]:
+    """Where the model's training and held-out meshes are in a collection, found by identity.
+
+    model : a fitted MeshVAEModel (``holdout_mask_``, ``mesh_digests_``).
+    vertices : (N, n, 3) float, the collection's meshes.
+
+    Returns ``(train, held)``: (k,) and (m,) int64 indices into ``vertices`` of the model's training
+    meshes found there and of all its held-out meshes, in the order the model was trained on them.
+    Each mesh is recognised by :func:`~meshvae_lib.geometry.collection.mesh_digests` of its
+    vertices, so the collection may list them in any order and may leave training meshes out. A
+    model without digests (read from a checkpoint of format 3 or older) takes them by position,
+    and the collection must then have as many meshes as it was trained on.
+
+    Raises ValueError when the model held out no meshes, when a held-out mesh is not in the
+    collection, or when the collection holds meshes that were not in the training collection.
+    """
+    from meshvae_lib.geometry.collection import find_meshes
+
+    mask = np.asarray(model.holdout_mask_, dtype=bool)
+    V = np.asarray(vertices)
+    digests = getattr(model, "mesh_digests_", None)
+    if digests is None and len(mask) != len(V):
+        raise ValueError(f"the model was trained on {len(mask)} meshes, this collection has {len(V)}:"
+                         " held-out meshes cannot be identified")
+    if not mask.any():
+        raise ValueError("the model was trained without held-out meshes (meshvae train --holdout-every K)")
+    if digests is None:
+        return np.flatnonzero(~mask), np.flatnonzero(mask)
+    order = np.concatenate([np.flatnonzero(mask), np.flatnonzero(~mask)])
+    found, missing = find_meshes([digests[k] for k in order], V)
+    held_missing = int((missing < mask.sum()).sum())
+    if held_missing:
+        raise ValueError(f"{held_missing} of the model's {int(mask.sum())} held-out meshes are not in this collection"
+                         " (a mesh is recognised by its vertex positions: give the training collection, in any order)")
+    other = np.setdiff1d(np.arange(len(V)), found)
+    if other.size:
+        raise ValueError(f"{other.size} of this collection's {len(V)} meshes were not in the model's training"
+                         f" collection (first: index {int(other[0])}): held-out meshes are measured only on the"
+                         " training collection")
+    n_held = int(mask.sum())
+    return found[n_held:], found[:n_held]
+
+
+def _evaluated(model, n: int, indices, held_out_only: bool, vertices=None) -> np.ndarray:
     """The indices of the meshes :func:`evaluate_model` measures, checked."""
     if held_out_only:
-        mask = np.asarray(model.holdout_mask_, dtype=bool)
-        if len(mask) != n:
-            raise ValueError(f"the model was trained on {len(mask)} meshes, this collection has {n}:"
-                             " held-out meshes cannot be identified")
-        if not mask.any():
-            raise ValueError("the model was trained without held-out meshes (holdout_every = 0)")
-        idx = np.flatnonzero(mask)
+        idx = training_split_of(model, vertices)[1]
     else:
         idx = np.arange(n) if indices is None else np.asarray(indices, dtype=np.int64).ravel()
     if idx.size == 0:

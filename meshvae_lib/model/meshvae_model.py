@@ -23,6 +23,7 @@ import numpy as np
 import torch
 
 from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INFERENCE, DEFAULT_LAYOUT
+from meshvae_lib.geometry.collection import mesh_digests
 from meshvae_lib.model import checkpoint
 from meshvae_lib.model.conditions import ConditionEncoder
 from meshvae_lib.model.feature_kinds import kind_from_state, make_kind
@@ -37,7 +38,8 @@ __all__ = ["MeshVAEModel", "load_model", "FITTED_ATTRIBUTES"]
 
 #: the attributes :meth:`MeshVAEModel.fit` sets and :func:`load_model` restores, all of them.
 FITTED_ATTRIBUTES = ("network_", "normalizer_", "kind_", "conditions_", "train_conditions_", "sigma_object_",
-                     "holdout_mask_", "train_config_", "history_", "train_seconds_", "train_epochs_", "selection_")
+                     "holdout_mask_", "mesh_digests_", "train_config_", "history_", "train_seconds_", "train_epochs_",
+                     "selection_")
 _HINT = "call fit(collection) or load_model(path) first"
 
 
@@ -51,8 +53,7 @@ class MeshVAEModel:
     config : :class:`~meshvae_lib.model.train_config.TrainConfig` (defaults when None); its
         ``architecture`` names the network.
     labels : label columns to condition on (conditional mesh VAE, Eq. 5); empty: unconditional.
-    holdout_every : hold out every k-th mesh (k >= 2) from training to measure generalisation;
-        0 trains on everything.
+    holdout_every : hold out every k-th mesh (k >= 2) to measure generalisation; 0 trains on everything.
     layout : RIMD layout ("paper" or "compact"; a kind without layout ignores it).
     reference_index : the reference mesh (default: the first mesh of the collection).
     inference : how :meth:`encode_meshes` and :meth:`reconstruct` find latent codes: a name of
@@ -69,12 +70,11 @@ class MeshVAEModel:
     sigma_object_ : (D,) float64 deviations of the prior :meth:`sample_latent` draws from: the
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
-    holdout_mask_ : (N,) bool, which meshes of the training collection were held out.
-    train_config_ : TrainConfig the network was trained with (``config`` or the defaults, resolved
-        once by :meth:`~meshvae_lib.model.train_config.TrainConfig.resolve`: latent size, ``a``,
-        ``feature_scale``; written into the checkpoint; ``config`` itself is left as given).
-    history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`).
-    train_seconds_ : float.
+    holdout_mask_ : (N,) bool, which meshes of the training collection were held out; ``mesh_digests_``:
+        N str, their identities (:func:`~meshvae_lib.geometry.collection.mesh_digests`; None: format 3).
+    train_config_ : TrainConfig the network was trained with (``config`` or the defaults, resolved once
+        by ``TrainConfig.resolve``; written into the checkpoint; ``config`` itself is left as given).
+    history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`); train_seconds_ : float.
     train_epochs_ : int, epochs the network was trained for (early stopping may choose fewer than
         ``config.epochs``, or 0: the PCA initialisation itself).
     selection_ : early stopping's record (see ``TrainResult.selection``) or None.
@@ -129,6 +129,7 @@ class MeshVAEModel:
         self.history_, self.train_seconds_ = result.history, result.seconds
         self.train_epochs_, self.selection_ = result.epochs, result.selection
         self.holdout_mask_ = mask
+        self.mesh_digests_ = mesh_digests(V)
         self.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
         self.sigma_object_ = so if so is not None and config.prior_form == "exact" else np.ones(D)
         self.train_config_ = config
@@ -298,19 +299,16 @@ class MeshVAEModel:
         Returns ``V (n, n_vertices, 3) float64``, or with ``return_latents`` ``(V, z (n, D)
         float64, c (n, C) float32 or None)``: the prior draws and condition vectors behind them.
         """
-        z = self.sample_latent(n, seed, temperature)
-        c = None
-        if self.is_conditional:
-            c = self.condition_vector(condition, n=n, seed=seed)
-        elif condition:
+        if condition and not self.is_conditional:
             raise ValueError(f"this model is unconditional; it takes no condition, got {condition!r}")
+        z = self.sample_latent(n, seed, temperature)
+        c = self.condition_vector(condition, n=n, seed=seed) if self.is_conditional else None
         V = np.asarray(self.decode_latent(z, conditions=c), dtype=np.float64).reshape(int(n), -1, 3)
         return (V, z, c) if return_latents else V
 
     # -- persistence ---------------------------------------------------------------------------
     def save(self, path) -> Path:
-        """Write the checkpoint (one file, written atomically; read it with :func:`load_model`).
-        Returns the path."""
+        """Write the checkpoint (one file, atomically; read it with :func:`load_model`). Returns the path."""
         return checkpoint.write_checkpoint(path, self.state_dict())
 
     def _params(self) -> dict:
@@ -320,8 +318,8 @@ class MeshVAEModel:
                 "layout": self.layout, "reference_index": int(self.reference_index), "inference": inference}
 
     def state_dict(self) -> dict:
-        """Everything that makes up the fitted model, as numpy arrays, tensors (the network's state),
-        numbers, strings, lists and dicts: what :mod:`~meshvae_lib.model.checkpoint` stores."""
+        """Everything that makes up the fitted model (arrays, tensors, numbers, strings, lists, dicts): what
+        :mod:`~meshvae_lib.model.checkpoint` stores (``mesh_digests`` too, so that its checks cover them)."""
         net = self._fitted().network_
         return {
             "architecture": net.architecture,
@@ -335,6 +333,7 @@ class MeshVAEModel:
             "train_config": self.train_config_.to_dict(),
             "estimator": self._params(),
             "holdout_mask": np.asarray(self.holdout_mask_, dtype=bool),
+            "mesh_digests": self.mesh_digests_,
             "history": [dict(h) for h in self.history_],
             "train_seconds": float(self.train_seconds_),
             "train_epochs": int(self.train_epochs_),
@@ -359,6 +358,7 @@ class MeshVAEModel:
         model.train_conditions_ = np.asarray(state["train_conditions"], dtype=np.float32)
         model.sigma_object_ = np.asarray(state["sigma_object"], dtype=np.float64)
         model.holdout_mask_ = np.asarray(state["holdout_mask"], dtype=bool)
+        model.mesh_digests_ = None if state.get("mesh_digests") is None else [str(d) for d in state["mesh_digests"]]
         model.train_config_ = config
         model.history_ = list(state["history"])
         model.train_seconds_ = float(state["train_seconds"])
