@@ -181,8 +181,8 @@ BAR_PROFILE_CLIP = 1.6
 #: knee), and the trunk's bend and twist with the head's nod and turn.
 POSES_N = 1200
 POSES_DOF = {
-    "l_arm_lower": (-0.9, 0.35), "l_arm_forward": (-0.5, 0.9), "l_arm_twist": (-0.6, 0.6), "l_elbow": (0.0, 1.6),
-    "r_arm_lower": (-0.9, 0.35), "r_arm_forward": (-0.5, 0.9), "r_arm_twist": (-0.6, 0.6), "r_elbow": (0.0, 1.6),
+    "l_arm_lower": (-0.9, 0.25), "l_arm_forward": (-0.3, 0.9), "l_arm_twist": (-0.6, 0.6), "l_elbow": (0.0, 1.6),
+    "r_arm_lower": (-0.9, 0.25), "r_arm_forward": (-0.3, 0.9), "r_arm_twist": (-0.6, 0.6), "r_elbow": (0.0, 1.6),
     "l_hip": (-0.35, 0.8), "l_knee": (0.0, 1.1), "r_hip": (-0.35, 0.8), "r_knee": (0.0, 1.1),
     "trunk_bend": (-0.1, 0.45), "trunk_twist": (-0.5, 0.5), "head_nod": (-0.15, 0.35), "head_turn": (-0.7, 0.7),
 }

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from meshvae_lib.model.corrected_decoder import CorrectedLinearDecoder, principal_directions
+from meshvae_lib.model.corrected_decoder import CorrectedLinearDecoder
+from meshvae_lib.model.gram_pca import principal_directions
 
 
 def torus_rows(n: int, seed: int, K: int = 40) -> np.ndarray:
@@ -156,7 +157,7 @@ def test_bad_rows_are_refused_showing_the_value():
 def test_gain_lower_bound_is_the_t_bound():
     from scipy.stats import t
 
-    from meshvae_lib.model.corrected_decoder import gain_lower_bound
+    from meshvae_lib.model.correction_choice import gain_lower_bound
 
     g = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
     # mean 3, std sqrt(2.5), t_0.975(4) = 2.776

@@ -21,15 +21,12 @@ that map from a few hundred meshes without memorising them. This estimator asks 
   refitted on all rows. So a few lucky rows do not choose the correction, and where it is kept its
   gain was measured on rows that neither trained nor stopped it.
 
-Rows are whatever a model's linear decoder fits: vertex coordinates (the ``coords`` kind) or the
-pre-activations ``atanh(x)`` of normalised RIMD rows. Codes of new rows are fitted to the rows (the
-projection, then L-BFGS through the corrected decoder).
+Rows are vertex coordinates (``output="linear"``) or normalised RIMD rows (``output="tanh"``).
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,81 +34,17 @@ from meshvae_lib.defaults import (CORRECTION_CHECK_EVERY, CORRECTION_CODE_PRIOR,
                                   CORRECTION_HIDDEN, CORRECTION_LR, CORRECTION_MAX_STEPS, CORRECTION_MIN_GAIN,
                                   CORRECTION_PATIENCE, CORRECTION_RANK, CORRECTION_VALIDATION_EVERY,
                                   CORRECTION_WEIGHT_DECAY)
-from meshvae_lib.tolerances import GRAM_RANK_RTOL, TANH_ROW_CLIP
+from meshvae_lib.model.correction_choice import CorrectionReport, gain_lower_bound
+from meshvae_lib.model.gram_pca import principal_directions
+from meshvae_lib.tolerances import TANH_ROW_CLIP
 from meshvae_lib.validation import check_is_fitted
 
-__all__ = ["CorrectedLinearDecoder", "CorrectionReport", "gain_lower_bound", "principal_directions"]
+__all__ = ["CorrectedLinearDecoder"]
 
 log = logging.getLogger(__name__)
 
 #: the fewest validation rows that choose between the corrected and the linear decoder (fewer: linear).
 MIN_CHOICE_ROWS = 3
-
-
-def principal_directions(Y: np.ndarray, max_rank: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The rows' mean and principal directions, through the small Gram matrix.
-
-    Y : (N >= 2, K) float64 rows; max_rank : the most directions to keep.
-    Returns ``mean (K,)``, ``basis (r, K)`` with orthonormal rows, most variance first, and
-    ``scale (r,)`` the coefficients' standard deviations (singular value / sqrt(N - 1)), where
-    r = min(max_rank, N - 1, the numerical rank) >= 1.
-    """
-    Y = np.asarray(Y, dtype=np.float64)
-    n = len(Y)
-    mean = Y.mean(axis=0)
-    Yc = Y - mean
-    w, U = np.linalg.eigh(Yc @ Yc.T)
-    order = np.argsort(w)[::-1]
-    s = np.sqrt(np.clip(w[order], 0.0, None))
-    U = U[:, order]
-    r = int(min(max_rank, n - 1, np.sum(s > s[0] * GRAM_RANK_RTOL))) if s[0] > 0 else 1
-    r = max(r, 1)
-    s_r = np.maximum(s[:r], s[0] * GRAM_RANK_RTOL if s[0] > 0 else 1.0)
-    basis = (U[:, :r].T @ Yc) / s_r[:, None]
-    return mean, basis, s_r / np.sqrt(max(n - 1, 1))
-
-
-def gain_lower_bound(gain: np.ndarray, confidence: float) -> float:
-    """The one-sided ``confidence`` lower bound of the mean of ``gain (n >= 2,)`` float (Student's t
-    with n - 1 degrees of freedom): ``mean - t_q(n - 1) * std / sqrt(n)``."""
-    from scipy.stats import t
-
-    gain = np.asarray(gain, dtype=np.float64).reshape(-1)
-    if gain.size < 2:
-        raise ValueError(f"need at least 2 gains for a bound, got {gain.size}")
-    return float(gain.mean() - t.ppf(confidence, gain.size - 1) * gain.std(ddof=1) / np.sqrt(gain.size))
-
-
-@dataclass
-class CorrectionReport:
-    """What :meth:`CorrectedLinearDecoder.fit` measured and chose.
-
-    kept : "corrected" or "linear"; reason : a sentence saying why; linear_validation,
-    corrected_validation : mean squared row error of the validation rows (per row, summed over the K
-    components) with the linear decoder and with the best corrected one (NaN where none was trained);
-    best_step, steps : the Adam step of the best validation error and the steps taken; n_fit,
-    n_validation : the rows trained on and set aside; curve : (step, training error, validation
-    error of the stopping rows) at every check; linear_score, corrected_score : the mean of ``score``
-    over the choosing rows for both decoders, and linear_errors, corrected_errors : their values row
-    by row; gain_lower_bound : the lower confidence bound of the mean gain per row
-    (:func:`gain_lower_bound`; the correction is kept only where it is above ``min_gain`` times the
-    linear decoder's mean error).
-    """
-
-    kept: str
-    reason: str
-    linear_validation: float
-    corrected_validation: float
-    best_step: int
-    steps: int
-    n_fit: int
-    n_validation: int
-    curve: list
-    linear_score: float = float("nan")
-    corrected_score: float = float("nan")
-    gain_lower_bound: float = float("nan")
-    linear_errors: list = field(default_factory=list)
-    corrected_errors: list = field(default_factory=list)
 
 
 class CorrectedLinearDecoder:
@@ -156,21 +89,10 @@ class CorrectedLinearDecoder:
                  patience: int = CORRECTION_PATIENCE, validation_every: int = CORRECTION_VALIDATION_EVERY,
                  min_gain: float = CORRECTION_MIN_GAIN, confidence: float = CORRECTION_CONFIDENCE, rank: int = CORRECTION_RANK,
                  fit_iterations: int = CORRECTION_FIT_ITERATIONS, output: str = "linear", seed: int = 0):
-        self.latent_dim = latent_dim
-        self.hidden = hidden
-        self.weight_decay = weight_decay
-        self.code_prior = code_prior
-        self.lr = lr
-        self.max_steps = max_steps
-        self.check_every = check_every
-        self.patience = patience
-        self.validation_every = validation_every
-        self.min_gain = min_gain
-        self.confidence = confidence
-        self.rank = rank
-        self.fit_iterations = fit_iterations
-        self.output = output
-        self.seed = seed
+        self.latent_dim, self.hidden, self.weight_decay, self.code_prior = latent_dim, hidden, weight_decay, code_prior
+        self.lr, self.max_steps, self.check_every, self.patience = lr, max_steps, check_every, patience
+        self.validation_every, self.min_gain, self.confidence = validation_every, min_gain, confidence
+        self.rank, self.fit_iterations, self.output, self.seed = rank, fit_iterations, output, seed
 
     # -- checks ------------------------------------------------------------------------------------
     def _check_params(self) -> None:
@@ -210,15 +132,11 @@ class CorrectedLinearDecoder:
         """Fit on training rows ``X (N, K)`` float (N >= latent_dim + 2; with ``output="tanh"`` in
         (-1, 1)). Returns self.
 
-        score : None, or ``score(rows (M, K), index (M,) int) -> (M,)``: the error of each validation
-            row's reconstruction ``rows`` against training row ``X[index]`` in the measure that
-            matters (the vertex error of the mesh it decodes to); None: the squared row error.
-            Training is steered by the squared error of the pre-activations; the final choice
-            between the corrected and the linear decoder is made by ``score``, both decoders'
-            validation codes fitted to the rows as :meth:`codes` fits them.
+        score : None (the squared row error), or ``score(rows (M, K), index (M,) int) -> (M,)``: the
+            error of each reconstruction ``rows`` of training row ``X[index]`` in the measure that
+            matters (e.g. the vertex error). Training follows the pre-activations' squared error; the
+            choice between the corrected and the linear decoder follows ``score``.
         """
-        import torch
-
         self._check_params()
         X = self._rows(X)
         n, D = len(X), int(self.latent_dim)
@@ -254,9 +172,61 @@ class CorrectedLinearDecoder:
         C_val = Yv @ basis.T / unit
         out_val = float(np.mean(np.sum(Yv * Yv, axis=1) - np.sum((C_val * unit) ** 2, axis=1)))
         energy = float(np.mean(np.sum(C_fit ** 2, axis=1)))
-        s = torch.tensor(scale[:D] / unit, dtype=torch.float64)
         linear_val = float(np.mean(np.sum(C_val[:, D:] ** 2, axis=1))) * unit ** 2 + out_val
 
+        net, best, best_step, best_state, step, curve = self._train(C_fit, C_val, scale, unit, energy, out_val)
+        report = dict(linear_validation=linear_val, corrected_validation=float(best), best_step=best_step,
+                      steps=step, n_fit=n_fit, n_validation=n_val, curve=curve)
+        if best_state is None:
+            self._keep_linear(Y, CorrectionReport("linear", "no validation check was reached", **report))
+            return self
+        net.load_state_dict(best_state)
+        net.eval()
+        idx = np.flatnonzero(choose)
+        self.mean_, self.basis_, self.scale_, self._unit, self.correction_ = mean, basis, scale, unit, None
+        linear_rows = self._decode(self._codes(X[choose]))
+        self.correction_ = net
+        corrected_rows = self._decode(self._codes(X[choose]))
+        if score is None:
+            e_lin = np.sum((linear_rows - X[choose]) ** 2, axis=1)
+            e_cor = np.sum((corrected_rows - X[choose]) ** 2, axis=1)
+        else:
+            e_lin = np.asarray(score(linear_rows, idx), dtype=np.float64).reshape(-1)
+            e_cor = np.asarray(score(corrected_rows, idx), dtype=np.float64).reshape(-1)
+        gain = e_lin - e_cor
+        bound = gain_lower_bound(gain, float(self.confidence))
+        report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound,
+                      linear_errors=e_lin.tolist(), corrected_errors=e_cor.tolist())
+        if bound > float(self.min_gain) * e_lin.mean():
+            self.report_ = CorrectionReport("corrected", f"validation error {e_cor.mean():.4g} against the linear "
+                f"decoder's {e_lin.mean():.4g} ({len(gain)} meshes; the gain's lower bound {bound:.3g} > "
+                f"{float(self.min_gain):.3g} x the linear error)", **report)
+        else:
+            self._keep_linear(Y, CorrectionReport("linear", f"the correction's validation error {e_cor.mean():.4g} "
+                f"against the linear decoder's {e_lin.mean():.4g} ({len(gain)} meshes): the gain's lower bound "
+                f"{bound:.3g} is not above {float(self.min_gain):.3g} x the linear error", **report))
+        log.info("corrected decoder (latent %d): kept the %s decoder (%s)", D, self.report_.kept, self.report_.reason)
+        return self
+
+    def fit_linear(self, X) -> "CorrectedLinearDecoder":
+        """Fit the linear decoder alone (what :meth:`fit` falls back to) on rows ``X (N, K)``: the
+        linear floor of the same capacity, with codes fitted as :meth:`codes` fits them. Returns self."""
+        self._check_params()
+        X = self._rows(X)
+        self.n_features_in_ = X.shape[1]
+        self._keep_linear(self._pre(X), CorrectionReport(
+            "linear", "fit_linear: no correction trained", float("nan"), float("nan"), 0, 0, len(X), 0, []))
+        return self
+
+    def _train(self, C_fit: np.ndarray, C_val: np.ndarray, scale: np.ndarray, unit: float, energy: float,
+               out_val: float):
+        """Adam on the free codes of coefficient rows ``C_fit (n_fit, r)`` and the correction, with
+        early stopping on the stopping rows ``C_val (n_stop, r)``. Returns the network, the best
+        validation error, its step and state (None if no check was reached), the steps and the curve."""
+        import torch
+
+        D, r = int(self.latent_dim), C_fit.shape[1]
+        s = torch.tensor(scale[:D] / unit, dtype=torch.float64)
         torch.manual_seed(int(self.seed))
         net = self._network(D, r)
         Ct = torch.tensor(C_fit)
@@ -284,50 +254,7 @@ class CorrectedLinearDecoder:
                     since += 1
                     if since >= int(self.patience):
                         break
-        report = dict(linear_validation=linear_val, corrected_validation=float(best), best_step=best_step,
-                      steps=step, n_fit=n_fit, n_validation=n_val, curve=curve)
-        if best_state is None:
-            self._keep_linear(Y, CorrectionReport("linear", "no validation check was reached", **report))
-            return self
-        net.load_state_dict(best_state)
-        net.eval()
-        idx = np.flatnonzero(choose)
-        self.mean_, self.basis_, self.scale_, self._unit, self.correction_ = mean, basis, scale, unit, None
-        linear_rows = self._decode(self._codes(X[choose]))
-        self.correction_ = net
-        corrected_rows = self._decode(self._codes(X[choose]))
-        if score is None:
-            e_lin = np.sum((linear_rows - X[choose]) ** 2, axis=1)
-            e_cor = np.sum((corrected_rows - X[choose]) ** 2, axis=1)
-        else:
-            e_lin = np.asarray(score(linear_rows, idx), dtype=np.float64).reshape(-1)
-            e_cor = np.asarray(score(corrected_rows, idx), dtype=np.float64).reshape(-1)
-        gain = e_lin - e_cor
-        bound = gain_lower_bound(gain, float(self.confidence))
-        report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound,
-                      linear_errors=e_lin.tolist(), corrected_errors=e_cor.tolist())
-        if bound > float(self.min_gain) * e_lin.mean():
-            self.report_ = CorrectionReport(
-                "corrected", f"validation error {e_cor.mean():.4g} against the linear decoder's "
-                f"{e_lin.mean():.4g} ({len(gain)} meshes; the gain's lower bound {bound:.3g} > "
-                f"{float(self.min_gain):.3g} x the linear error)", **report)
-        else:
-            self._keep_linear(Y, CorrectionReport(
-                "linear", f"the correction's validation error {e_cor.mean():.4g} against the linear decoder's "
-                f"{e_lin.mean():.4g} ({len(gain)} meshes): the gain's lower bound {bound:.3g} is not above "
-                f"{float(self.min_gain):.3g} x the linear error", **report))
-        log.info("corrected decoder (latent %d): kept the %s decoder (%s)", D, self.report_.kept, self.report_.reason)
-        return self
-
-    def fit_linear(self, X) -> "CorrectedLinearDecoder":
-        """Fit the linear decoder alone (what :meth:`fit` falls back to) on rows ``X (N, K)``: the
-        linear floor of the same capacity, with codes fitted as :meth:`codes` fits them. Returns self."""
-        self._check_params()
-        X = self._rows(X)
-        self.n_features_in_ = X.shape[1]
-        self._keep_linear(self._pre(X), CorrectionReport(
-            "linear", "fit_linear: no correction trained", float("nan"), float("nan"), 0, 0, len(X), 0, []))
-        return self
+        return net, best, best_step, best_state, step, curve
 
     def _pre(self, X: np.ndarray) -> np.ndarray:
         """The rows' pre-activations: ``atanh`` of rows clipped into (-1, 1) for a tanh output."""
