@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvae_lib.model.gram_pca import principal_directions
 from meshvae_lib.model.posterior import linear_gaussian_sigma
 from meshvae_lib.tolerances import PCA_INIT_RTOL
 
@@ -55,18 +56,10 @@ def pca_start(X: np.ndarray, latent_dim: int, alpha: float) -> PCAStart:
       so that tanh(b + W mu) reproduces every training row when r = N - 1.
     """
     n, k = X.shape
-    mean = X.mean(axis=0)
-    Xc = X - mean
     # SVD through the small (N, N) Gram matrix: K may be ~1e5-1e6, N ~ 1e2
-    w, U = np.linalg.eigh(Xc @ Xc.T)
-    order = np.argsort(w)[::-1]
-    s = np.sqrt(np.clip(w[order], 0.0, None))
-    U = U[:, order]
-    r = int(min(latent_dim, n - 1, np.sum(s > s[0] * PCA_INIT_RTOL))) if s[0] > 0 else 0
-    r = max(r, 1)
-    s_r = np.maximum(s[:r], s[0] * PCA_INIT_RTOL if s[0] > 0 else 1.0)
-    V = (U[:, :r].T @ Xc) / s_r[:, None]  # (r, K) orthonormal directions
-    c = s_r / np.sqrt(max(n - 1, 1))
+    mean, V, c = principal_directions(X, latent_dim, rtol=PCA_INIT_RTOL)  # V: (r, K) orthonormal directions
+    r = len(c)
+    Xc = X - mean
     Z = Xc @ V.T / c  # (N, r) whitened coefficients
     A = np.arctanh(np.clip(X, -1 + 1e-6, 1 - 1e-6))
     sol, *_ = np.linalg.lstsq(np.c_[Z, np.ones(n)], A, rcond=None)  # (r + 1, K)
