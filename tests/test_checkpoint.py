@@ -266,9 +266,9 @@ def test_network_options_round_trip_through_the_checkpoint(collection, tmp_path)
 
 
 def _format_3(payload: dict) -> dict:
-    """A format-4 payload written back as format 3: no mesh digests, and a checksum of the weights,
+    """A format-4 payload written back as format 3: no mesh fingerprints, and a checksum of the weights,
     the reference mesh and the faces instead of the digest of everything."""
-    old = {k: v for k, v in payload.items() if k not in ("digest", "mesh_digests")}
+    old = {k: v for k, v in payload.items() if k not in ("digest", "mesh_fingerprints")}
     kind = payload["kind"]
     return dict(old, version=3, checksum=_checksum(payload["network_state"], kind["reference"].numpy(),
                                                    kind["faces"].numpy()))
@@ -326,7 +326,7 @@ def test_any_edit_of_a_checkpoint_is_refused(model, collection, tmp_path):
         "normaliser": lambda p: p["normalizer"].update(max=p["normalizer"]["max"] * 1.5),
         "config": lambda p: p["train_config"].update(lr=p["train_config"]["lr"] * 2),
         "held-out": lambda p: p["holdout_mask"].logical_not_(),
-        "digests": lambda p: p["mesh_digests"].reverse(),
+        "fingerprints": lambda p: p.update(mesh_fingerprints=p["mesh_fingerprints"].flip(0).clone()),
         "version": lambda p: p.update(version=3),
     }
     for name, edit in edits.items():
@@ -370,8 +370,8 @@ def test_held_out_meshes_are_found_by_identity_in_any_order(model, collection, t
     plus = MeshCollection(np.concatenate([collection.vertices, other.vertices[:1]]), collection.faces)
     with pytest.raises(ValueError, match=f"1 of this collection's {len(plus)} meshes were not in the model's training"):
         training_split_of(loaded, plus.vertices)
-    # a file of format 3 has no digests: its held-out meshes are taken by position, as before
+    # a file of format 3 has no fingerprints: its held-out meshes are taken by position, as before
     torch.save(_format_3(torch.load(tmp_path / "m.pt", weights_only=True)), tmp_path / "v3.pt")
     v3 = load_model(tmp_path / "v3.pt", collection)
-    assert v3.mesh_digests_ is None
+    assert v3.mesh_fingerprints_ is None
     assert evaluate_model(v3, collection, held_out_only=True, inference="encoder")["indices"] == held.tolist()

@@ -152,7 +152,7 @@ def _issue_50_data(ns, root: Path, coll, model: Path) -> None:
     ns.held_model = root / "held.pt"
     assert main(["train", str(ns.data), "-o", str(ns.held_model), "--epochs", "2", "--latent", "2", "--holdout-every", "4",
                  "--no-progress"]) == 0
-    old = {k: v for k, v in torch.load(ns.held_model, weights_only=True).items() if k not in ("digest", "mesh_digests")}
+    old = {k: v for k, v in torch.load(ns.held_model, weights_only=True).items() if k not in ("digest", "mesh_fingerprints")}
     ns.v3_model = root / "v3.pt"  # written before held-out meshes were recorded (format 3)
     torch.save(dict(old, version=3, checksum=_checksum(old["network_state"], old["kind"]["reference"].numpy(),
                                                        old["kind"]["faces"].numpy())), ns.v3_model)

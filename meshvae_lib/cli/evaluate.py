@@ -102,7 +102,7 @@ def _chosen_meshes(args, model, collection):
     V = np.asarray(collection.vertices, dtype=np.float64)
     split = None
     if args.held_out or args.pca == "":
-        if args.held_out and model.mesh_digests_ is None:
+        if args.held_out and model.mesh_fingerprints_ is None:
             raise UsageError(f"{_file(args.model)} was written by an older version that did not record which"
                              " meshes it held out: --held-out cannot find them; retrain it")
         try:

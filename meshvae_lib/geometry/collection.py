@@ -13,7 +13,7 @@ import numpy as np
 
 from meshvae_lib.validation import check_faces, check_vertices
 
-__all__ = ["MeshCollection", "default_names", "mesh_digests", "find_meshes"]
+__all__ = ["MeshCollection", "default_names", "mesh_fingerprints", "find_meshes"]
 
 
 @dataclass
@@ -86,33 +86,56 @@ def default_names(n: int) -> list[str]:
     return [f"{k:0{width}d}" for k in range(n)]
 
 
-def mesh_digests(vertices) -> list[str]:
-    """The identity of each mesh: a digest (blake2b, 32 hex digits) of its vertex positions as
-    float64 bytes, so that a mesh read back from an ``.npz``, an OBJ, OFF or PLY file (all of which
-    keep float64 positions exactly) is recognised whatever its name or place in a collection.
+def mesh_fingerprints(vertices) -> np.ndarray:
+    """The identity of each mesh, robust to round-off: its vertex positions, flattened to a row of
+    3n numbers, projected on ``MESH_FINGERPRINT_DIRECTIONS`` fixed unit directions (standard normal,
+    drawn from a fixed seed, the same on every machine), followed by the row's Euclidean length.
 
-    vertices : (n_meshes, n_vertices, 3) float. Returns a list of n_meshes str.
+    Two builds of the same mesh on machines whose BLAS rounds differently (positions equal to
+    about 1e-15 relative) give fingerprints equal within :data:`MESH_IDENTITY_RTOL`; so does a mesh
+    read back from an ``.npz``, OBJ, OFF or PLY file. Meshes that differ by more than about
+    ``MESH_IDENTITY_RTOL * sqrt(3n)`` of their length differ in at least one projection.
+
+    vertices : (n_meshes, n_vertices, 3) float. Returns (n_meshes, MESH_FINGERPRINT_DIRECTIONS + 1)
+    float64.
     """
-    import hashlib
+    from meshvae_lib.tolerances import MESH_FINGERPRINT_DIRECTIONS, MESH_FINGERPRINT_SEED
 
-    V = np.ascontiguousarray(check_vertices(vertices, "vertices", batch=True), dtype="<f8")
-    return [hashlib.blake2b(V[k].tobytes(), digest_size=16).hexdigest() for k in range(len(V))]
+    V = np.asarray(check_vertices(vertices, "vertices", batch=True), dtype=np.float64)
+    rows = V.reshape(len(V), -1)
+    W = np.random.default_rng(MESH_FINGERPRINT_SEED).standard_normal((rows.shape[1], MESH_FINGERPRINT_DIRECTIONS))
+    W /= np.linalg.norm(W, axis=0)
+    return np.concatenate([rows @ W, np.linalg.norm(rows, axis=1)[:, None]], axis=1)
 
 
-def find_meshes(digests, vertices) -> tuple[np.ndarray, np.ndarray]:
-    """Where the meshes with ``digests`` (:func:`mesh_digests`) are among ``vertices``.
+def find_meshes(fingerprints, vertices) -> tuple[np.ndarray, np.ndarray]:
+    """Where the meshes with ``fingerprints`` (:func:`mesh_fingerprints`) are among ``vertices``.
 
-    digests : list of str (a digest may repeat: as many equal meshes are then looked for).
+    fingerprints : (k, MESH_FINGERPRINT_DIRECTIONS + 1) float (a fingerprint may repeat: as many
+        equal meshes are then looked for).
     vertices : (n_meshes, n_vertices, 3) float.
 
-    Returns ``(found, missing)``: ``found`` (k,) int64, for each digest found the index of its mesh
-    in ``vertices`` (each index used once, in the order of ``digests``); ``missing`` (m,) int64, the
-    positions in ``digests`` of those not found.
+    A mesh matches a fingerprint when every entry agrees within ``MESH_IDENTITY_RTOL`` times the
+    larger of the two lengths; among several matches the closest unused one is taken.
+
+    Returns ``(found, missing)``: ``found`` (k',) int64, for each fingerprint found the index of its
+    mesh in ``vertices`` (each index used once, in the order of ``fingerprints``); ``missing``
+    (m,) int64, the positions in ``fingerprints`` of those not found.
     """
-    places: dict[str, list[int]] = {}
-    for k, d in enumerate(mesh_digests(vertices)):
-        places.setdefault(d, []).append(k)
+    from meshvae_lib.tolerances import DIVISION_FLOOR, MESH_IDENTITY_RTOL
+
+    here = mesh_fingerprints(vertices)
+    wanted = np.asarray(fingerprints, dtype=np.float64).reshape(-1, here.shape[1])
+    free = np.ones(len(here), dtype=bool)
     found, missing = [], []
-    for j, d in enumerate(digests):
-        (found.append(places[d].pop(0)) if places.get(d) else missing.append(j))
+    for j, f in enumerate(wanted):  # one pass per wanted mesh (not per vertex), each over all meshes
+        scale = np.maximum(np.abs(here[:, -1]), abs(f[-1])) + DIVISION_FLOOR
+        gap = np.abs(here - f).max(axis=1) / scale
+        gap[~free] = np.inf
+        i = int(np.argmin(gap)) if len(gap) else -1
+        if i >= 0 and gap[i] <= MESH_IDENTITY_RTOL:
+            free[i] = False
+            found.append(i)
+        else:
+            missing.append(j)
     return np.asarray(found, dtype=np.int64), np.asarray(missing, dtype=np.int64)

@@ -6,7 +6,7 @@ back (``meshvae_model.load_model`` builds the model from it). A checkpoint is on
 ``torch.save`` that holds only tensors, numbers, strings, lists and dicts (it loads with
 ``weights_only=True``: no code runs when reading it), plus a digest of everything else it holds
 (:func:`payload_digest`: the weights, the normaliser, the reference mesh, the configuration, the
-held-out meshes' digests, the history), so that a corrupted, truncated, edited or foreign file
+held-out meshes' fingerprints, the history), so that a corrupted, truncated, edited or foreign file
 gives a clear error instead of a broken model. Files of formats 1 to 3 are read too
 (:func:`read_checkpoint` upgrades them); their checksum covers only the weights, the reference mesh
 and the faces.
@@ -36,7 +36,7 @@ CHECKPOINT_FORMAT = "meshvae-checkpoint"
 #: version 1 files load with their defaults, 0 and "tanh"; 3: the network's ``architecture``, the feature
 #: kind's state instead of the feature extractor's, the epochs trained and early stopping's record;
 #: 4: a ``digest`` of everything stored instead of a ``checksum`` of the weights and the reference
-#: mesh, and the digest of every training mesh, ``mesh_digests``).
+#: mesh, and the fingerprint of every training mesh, ``mesh_fingerprints``).
 CHECKPOINT_VERSION = 4
 
 
@@ -210,7 +210,7 @@ def read_checkpoint(path) -> dict:
             kind = state["kind"]
             if _checksum(state["network_state"], kind["reference"], kind["faces"]) != payload["checksum"]:
                 raise ValueError(f"{path} is corrupted: its weights do not match the stored checksum")
-            state.setdefault("mesh_digests", None)
+            state.setdefault("mesh_fingerprints", None)
     except (KeyError, TypeError, RuntimeError, AttributeError) as exc:
         raise ValueError(f"{path} is an incomplete or inconsistent mesh VAE checkpoint: {exc!r}") from exc
     return state

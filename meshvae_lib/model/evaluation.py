@@ -96,14 +96,14 @@ def evaluate_model(model, collection, indices=None, held_out_only: bool = False,
 def training_split_of(model, vertices) -> tuple[np.ndarray, np.ndarray]:
     """Where the model's training and held-out meshes are in a collection, found by identity.
 
-    model : a fitted MeshVAEModel (``holdout_mask_``, ``mesh_digests_``).
+    model : a fitted MeshVAEModel (``holdout_mask_``, ``mesh_fingerprints_``).
     vertices : (N, n, 3) float, the collection's meshes.
 
     Returns ``(train, held)``: (k,) and (m,) int64 indices into ``vertices`` of the model's training
     meshes found there and of all its held-out meshes, in the order the model was trained on them.
-    Each mesh is recognised by :func:`~meshvae_lib.geometry.collection.mesh_digests` of its
-    vertices, so the collection may list them in any order and may leave training meshes out. A
-    model without digests (read from a checkpoint of format 3 or older) takes them by position,
+    Each mesh is recognised by :func:`~meshvae_lib.geometry.collection.mesh_fingerprints` of its
+    vertices (equal up to round-off), so the collection may list them in any order and may leave training meshes out. A
+    model without fingerprints (read from a checkpoint of format 3 or older) takes them by position,
     and the collection must then have as many meshes as it was trained on.
 
     Raises ValueError when the model held out no meshes, when a held-out mesh is not in the
@@ -113,16 +113,16 @@ def training_split_of(model, vertices) -> tuple[np.ndarray, np.ndarray]:
 
     mask = np.asarray(model.holdout_mask_, dtype=bool)
     V = np.asarray(vertices)
-    digests = getattr(model, "mesh_digests_", None)
-    if digests is None and len(mask) != len(V):
+    prints = model.mesh_fingerprints_
+    if prints is None and len(mask) != len(V):
         raise ValueError(f"the model was trained on {len(mask)} meshes, this collection has {len(V)}:"
                          " held-out meshes cannot be identified")
     if not mask.any():
         raise ValueError("the model was trained without held-out meshes (meshvae train --holdout-every K)")
-    if digests is None:
+    if prints is None:
         return np.flatnonzero(~mask), np.flatnonzero(mask)
     order = np.concatenate([np.flatnonzero(mask), np.flatnonzero(~mask)])
-    found, missing = find_meshes([digests[k] for k in order], V)
+    found, missing = find_meshes(np.asarray(prints)[order], V)
     held_missing = int((missing < mask.sum()).sum())
     if held_missing:
         raise ValueError(f"{held_missing} of the model's {int(mask.sum())} held-out meshes are not in this collection"

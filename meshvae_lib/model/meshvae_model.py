@@ -23,7 +23,7 @@ import numpy as np
 import torch
 
 from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INFERENCE, DEFAULT_LAYOUT
-from meshvae_lib.geometry.collection import mesh_digests
+from meshvae_lib.geometry.collection import mesh_fingerprints
 from meshvae_lib.model import checkpoint
 from meshvae_lib.model.conditions import ConditionEncoder
 from meshvae_lib.model.feature_kinds import kind_from_state, make_kind
@@ -38,7 +38,7 @@ __all__ = ["MeshVAEModel", "load_model", "FITTED_ATTRIBUTES"]
 
 #: the attributes :meth:`MeshVAEModel.fit` sets and :func:`load_model` restores, all of them.
 FITTED_ATTRIBUTES = ("network_", "normalizer_", "kind_", "conditions_", "train_conditions_", "sigma_object_",
-                     "holdout_mask_", "mesh_digests_", "train_config_", "history_", "train_seconds_", "train_epochs_",
+                     "holdout_mask_", "mesh_fingerprints_", "train_config_", "history_", "train_seconds_", "train_epochs_",
                      "selection_")
 _HINT = "call fit(collection) or load_model(path) first"
 
@@ -70,8 +70,9 @@ class MeshVAEModel:
     sigma_object_ : (D,) float64 deviations of the prior :meth:`sample_latent` draws from: the
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
-    holdout_mask_ : (N,) bool, which meshes of the training collection were held out; ``mesh_digests_``:
-        N str, their identities (:func:`~meshvae_lib.geometry.collection.mesh_digests`; None: format 3).
+    holdout_mask_ : (N,) bool, which meshes of the training collection were held out; ``mesh_fingerprints_``:
+        (N, 17) float64, their identities (:func:`~meshvae_lib.geometry.collection.mesh_fingerprints`;
+        None: format 3).
     train_config_ : TrainConfig the network was trained with (``config`` or the defaults, resolved once
         by ``TrainConfig.resolve``; written into the checkpoint; ``config`` itself is left as given).
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`); train_seconds_ : float.
@@ -129,7 +130,7 @@ class MeshVAEModel:
         self.history_, self.train_seconds_ = result.history, result.seconds
         self.train_epochs_, self.selection_ = result.epochs, result.selection
         self.holdout_mask_ = mask
-        self.mesh_digests_ = mesh_digests(V)
+        self.mesh_fingerprints_ = mesh_fingerprints(V)
         self.train_conditions_ = np.zeros((int((~mask).sum()), 0), np.float32) if C is None else C[~mask]
         self.sigma_object_ = so if so is not None and config.prior_form == "exact" else np.ones(D)
         self.train_config_ = config
@@ -319,7 +320,7 @@ class MeshVAEModel:
 
     def state_dict(self) -> dict:
         """Everything that makes up the fitted model (arrays, tensors, numbers, strings, lists, dicts): what
-        :mod:`~meshvae_lib.model.checkpoint` stores (``mesh_digests`` too, so that its checks cover them)."""
+        :mod:`~meshvae_lib.model.checkpoint` stores (``mesh_fingerprints`` too, so that its checks cover them)."""
         net = self._fitted().network_
         return {
             "architecture": net.architecture,
@@ -333,7 +334,7 @@ class MeshVAEModel:
             "train_config": self.train_config_.to_dict(),
             "estimator": self._params(),
             "holdout_mask": np.asarray(self.holdout_mask_, dtype=bool),
-            "mesh_digests": self.mesh_digests_,
+            "mesh_fingerprints": self.mesh_fingerprints_,
             "history": [dict(h) for h in self.history_],
             "train_seconds": float(self.train_seconds_),
             "train_epochs": int(self.train_epochs_),
@@ -358,7 +359,8 @@ class MeshVAEModel:
         model.train_conditions_ = np.asarray(state["train_conditions"], dtype=np.float32)
         model.sigma_object_ = np.asarray(state["sigma_object"], dtype=np.float64)
         model.holdout_mask_ = np.asarray(state["holdout_mask"], dtype=bool)
-        model.mesh_digests_ = None if state.get("mesh_digests") is None else [str(d) for d in state["mesh_digests"]]
+        prints = state.get("mesh_fingerprints")
+        model.mesh_fingerprints_ = None if prints is None else np.asarray(prints, dtype=np.float64)
         model.train_config_ = config
         model.history_ = list(state["history"])
         model.train_seconds_ = float(state["train_seconds"])
