@@ -34,7 +34,7 @@ from meshvae_lib.defaults import (CORRECTION_CHECK_EVERY, CORRECTION_CODE_PRIOR,
                                   CORRECTION_HIDDEN, CORRECTION_LR, CORRECTION_MAX_STEPS, CORRECTION_MIN_CHOICE_ROWS, CORRECTION_MIN_GAIN,
                                   CORRECTION_PATIENCE, CORRECTION_RANK, CORRECTION_VALIDATION_EVERY,
                                   CORRECTION_WEIGHT_DECAY)
-from meshvae_lib.model.correction_choice import CorrectionReport, gain_lower_bound
+from meshvae_lib.model.correction_choice import CorrectionReport, checked_scores, gain_lower_bound
 from meshvae_lib.model.gram_pca import principal_directions
 from meshvae_lib.tolerances import CODE_FIT_CHANGE_TOL, CODE_FIT_GRAD_TOL, TANH_ROW_CLIP
 from meshvae_lib.validation import check_is_fitted
@@ -191,7 +191,7 @@ class CorrectedLinearDecoder:
             e_lin = np.sum((linear_rows - X[choose]) ** 2, axis=1)
             e_cor = np.sum((corrected_rows - X[choose]) ** 2, axis=1)
         else:
-            e_lin, e_cor = (self._scored(score, rows, idx) for rows in (linear_rows, corrected_rows))
+            e_lin, e_cor = (checked_scores(score, rows, idx) for rows in (linear_rows, corrected_rows))
         gain = e_lin - e_cor
         bound = gain_lower_bound(gain, float(self.confidence))
         report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound,
@@ -206,15 +206,6 @@ class CorrectedLinearDecoder:
                 f"{bound:.3g} is not above {float(self.min_gain):.3g} x the linear error", **report))
         log.info("corrected decoder (latent %d): kept the %s decoder (%s)", D, self.report_.kept, self.report_.reason)
         return self
-
-    @staticmethod
-    def _scored(score, rows: np.ndarray, idx: np.ndarray) -> np.ndarray:
-        """``score(rows, idx)`` checked: (M,) finite float64."""
-        e = np.asarray(score(rows, idx), dtype=np.float64)
-        if e.shape != (len(idx),) or not np.isfinite(e).all():
-            raise ValueError(f"score must return ({len(idx)},) finite errors, got shape {e.shape}"
-                             f" with {int((~np.isfinite(e)).sum()) if e.size else 0} non-finite values")
-        return e
 
     def fit_linear(self, X) -> "CorrectedLinearDecoder":
         """Fit the linear decoder alone (what :meth:`fit` falls back to) on rows ``X (N, K)``: the
