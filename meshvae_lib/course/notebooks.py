@@ -275,8 +275,8 @@ def rerun_answer(namespace: dict, names, **inputs):
     namespace : the notebook's globals (``globals()`` in the check cell); names : the answer's name,
     or a sequence of names; inputs : the names the cell reads, given other values (``a=3, b=7``).
 
-    The student's cell is the latest cell before the running one, in the kernel's history
-    (``In``), that binds every one of ``names`` at module scope (:func:`bound_names`); it runs
+    The student's cell is the latest cell before the running one, among those the kernel ran since
+    this module was imported (else in the kernel's history ``In``), that binds every one of ``names`` at module scope (:func:`bound_names`); it runs
     in a copy of ``namespace`` with ``inputs`` in place, so the notebook's own names keep their
     values (objects the cell changes in place are changed, as a rerun of the cell would). (A
     :func:`trivial_answer_notebook` gives the code it runs in place of the solution under
@@ -292,7 +292,7 @@ def rerun_answer(namespace: dict, names, **inputs):
     wanted = [names] if isinstance(names, str) else list(names)
     source = namespace.get(ANSWER_SOURCE)
     if source is None:
-        history = list(namespace.get("In", namespace.get("_ih", [])))[:-1]   # the last is the running cell
+        history = (_RECORDED or list(namespace.get("In", namespace.get("_ih", []))))[:-1]   # the last is the running cell
         source = next((cell for cell in reversed(history) if cell and set(wanted) <= set(_bound_or_none(cell))), None)
         if source is None:
             raise LookupError(f"no earlier cell binds {wanted}: write the answer in one cell, in terms of "
@@ -305,6 +305,29 @@ def rerun_answer(namespace: dict, names, **inputs):
         raise LookupError(f"run again, the answer's cell left {missing} unbound")
     values = tuple(scope[n] for n in wanted)
     return values[0] if isinstance(names, str) else values
+
+
+#: the cells this IPython kernel ran since the module was imported, as Python (magics translated):
+#: the kernel's own history (``In``) stays empty where cells run without it (nbval's
+#: ``store_history=False``).
+_RECORDED: list[str] = []
+
+
+def _record_cells() -> None:
+    """Append every cell the running IPython kernel starts to :data:`_RECORDED` (once per kernel;
+    nothing outside IPython)."""
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return
+    shell = get_ipython()
+    if shell is None or getattr(shell, "_meshvae_records_cells", False):
+        return
+    shell.events.register("pre_run_cell", lambda info: _RECORDED.append(shell.transform_cell(info.raw_cell or "")))
+    shell._meshvae_records_cells = True
+
+
+_record_cells()
 
 
 def _bound_or_none(code: str) -> list[str]:
