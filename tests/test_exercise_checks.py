@@ -16,7 +16,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from meshvae_lib.course.notebooks import (TRIVIAL_ANSWERS, solution_names, trivial_answer_notebook,
+from meshvae_lib.course.notebooks import (TRIVIAL_ANSWERS, rerun_answer, solution_names, trivial_answer_notebook,
                                           trivial_answer_outcomes)
 
 NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
@@ -100,6 +100,39 @@ def test_the_trivial_answer_notebook_tries_named_wrong_answers():
         trivial_answer_notebook(nb, wrong_answers={3: {"x": "pass"}})
     with pytest.raises(ValueError, match="trivial answers' names"):
         trivial_answer_notebook(nb, wrong_answers={1: {"None": "answer = None"}})
+
+
+def test_rerun_answer_runs_the_latest_cell_that_binds_the_answer_on_other_inputs():
+    history = ["", "x = 3", "### BEGIN SOLUTION\nanswer = x * 2\nother = 1\n### END SOLUTION", "print(answer)",
+               "assert rerun_answer(globals(), 'answer', x=5) == 10"]
+    ns = {"In": history, "x": 3, "answer": 6}
+    assert rerun_answer(ns, "answer", x=5) == 10
+    assert rerun_answer(ns, ["answer", "other"], x=1) == (2, 1)
+    assert ns["x"] == 3 and ns["answer"] == 6, "the notebook's own names keep their values"
+    pasted = {**ns, "In": history[:2] + ["answer = 6"] + history[3:]}
+    assert rerun_answer(pasted, "answer", x=5) == 6, "a typed-in answer stays what it was"
+    with pytest.raises(LookupError, match="no earlier cell binds"):
+        rerun_answer({"In": ["x = 3", "rerun_answer(...)"]}, "answer", x=5)
+    nb = nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell("x = 3"),
+        nbformat.v4.new_code_cell("### BEGIN SOLUTION\nanswer = x * 2\n### END SOLUTION"),
+        nbformat.v4.new_code_cell("from meshvae_lib.course.notebooks import rerun_answer\n"
+                                  "assert answer == 2 * x and rerun_answer(globals(), 'answer', x=5) == 10"),
+    ])
+    out, _ = trivial_answer_notebook(nb, wrong_answers={1: {"typed in": "answer = 6", "doubled by hand": "answer = x + x"}})
+    ns, printed = {"In": []}, []
+    import contextlib
+    import io
+
+    for cell in out.cells:   # as a kernel would: the running cell is the last entry of In
+        ns["In"].append(cell.source)
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            exec(cell.source, ns)
+        printed.append(buf.getvalue())
+    line = [p for p in printed if "TRIVIAL" in p][-1]
+    assert '"typed in": "AssertionError"' in line and '"doubled by hand": "passed"' in line
+    assert "_t_answer_source" not in ns, "the harness leaves no answer source behind for the real check"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)

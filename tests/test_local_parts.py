@@ -9,7 +9,7 @@ import pytest
 import torch
 
 from geometry_fixtures import icosphere, strip, tube
-from meshvae_lib.applications.generation import mix_parts
+from meshvae_lib.applications.generation import mix_parts, parts_code
 from meshvae_lib.geometry.alignment import rigid_align
 from meshvae_lib.geometry.collection import MeshCollection
 from meshvae_lib.geometry.regions import kmeans_labels, mesh_regions
@@ -211,6 +211,22 @@ def test_mix_parts_takes_each_regions_dimensions_from_its_source(rng):
     np.testing.assert_array_equal(z2, z)
     with pytest.raises(ValueError, match="latent_region"):
         mix_parts(codes, latent_region[:4], 2)
+
+
+def test_parts_code_takes_each_regions_dimensions_from_the_chosen_code(rng):
+    codes = rng.normal(size=(6, 6))
+    latent_region = np.array([1, 1, 0, 0, 2, 2])      # regions in increasing number: 0, 1, 2
+    z = parts_code(codes, latent_region, [[4, 2, 5], [0, 0, 0]])
+    np.testing.assert_array_equal(z[0], [codes[2, 0], codes[2, 1], codes[4, 2], codes[4, 3], codes[5, 4], codes[5, 5]])
+    np.testing.assert_array_equal(z[1], codes[0])
+    zm, sources = mix_parts(codes, latent_region, 5, seed=3)
+    np.testing.assert_array_equal(parts_code(codes, latent_region, sources), zm)
+    with pytest.raises(ValueError, match="sources must be"):
+        parts_code(codes, latent_region, [[0, 1]])
+    with pytest.raises(ValueError, match="sources must be"):
+        parts_code(codes, latent_region, [[0.0, 1.0, 2.0]])
+    with pytest.raises(ValueError, match="index the 6 codes"):
+        parts_code(codes, latent_region, [[0, 1, 6]])
 
 
 def test_mixed_parts_of_the_two_ends_are_new_combinations(two_ends):

@@ -10,7 +10,7 @@ from meshvae_lib.exports import exports_of, lazy_exports
 
 #: module (under this package) and the public names it defines, one line each.
 EXPORTS = exports_of(__name__, """
-generation     mix_parts
+generation     mix_parts parts_code
 interpolation  edge_length_distortion vertex_edge_stretch
 """)
 

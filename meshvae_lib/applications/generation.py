@@ -16,10 +16,10 @@ copy.
 A decoder of local parts (:class:`~meshvae_lib.model.local_parts.LocalPartsVAE`) also generates by
 mixing parts (``mix_parts``): each region's latent dimensions taken from the code of a training
 mesh drawn for that region, so the new mesh has this pose's arm and that pose's legs (the paper's
-reading of its Fig. 2).
+reading of its Fig. 2); ``parts_code`` builds such a code from sources chosen by hand.
 
 Public names: ``nearest_training_meshes``, ``GenerationResult``, ``nearest_neighbors``,
-``dataset_feature_rows``, ``condition_agreement``, ``mix_parts``. (Meshes alone, without the comparison:
+``dataset_feature_rows``, ``condition_agreement``, ``mix_parts``, ``parts_code``. (Meshes alone, without the comparison:
 ``MeshVAEModel.generate``; prior draws: ``MeshVAEModel.sample_latent``.)
 """
 
@@ -34,7 +34,7 @@ from meshvae_lib.tolerances import DUPLICATE_DISTANCE_RTOL
 from meshvae_lib.validation import check_choice, check_count, check_vertices
 
 __all__ = ["nearest_neighbors", "dataset_feature_rows", "nearest_training_meshes", "GenerationResult",
-           "condition_agreement", "mix_parts", "FEATURE_SPACES"]
+           "condition_agreement", "mix_parts", "parts_code", "FEATURE_SPACES"]
 
 #: the spaces nearest neighbours are searched in: RIMD features in the paper's layout (Sec. 5.2's
 #: distance, whatever the model's own features and layout), or the model's own feature rows.
@@ -273,8 +273,32 @@ def mix_parts(codes, latent_region, n: int, seed: int = 0, neighbours: int | Non
         d2 = np.sum((Z[base][:, None, :] - Z[None, :, :]) ** 2, axis=-1)  # (n, M)
         near = np.argsort(d2, axis=1, kind="stable")[:, :k]
         sources = np.take_along_axis(near, rng.integers(0, k, size=(n, len(regions))), axis=1)
-    z = np.empty((n, Z.shape[1]))
+    return parts_code(Z, labels, sources), sources
+
+
+def parts_code(codes, latent_region, sources) -> np.ndarray:
+    """Codes whose every region's dimensions are those of a chosen code: the mix of parts by hand.
+
+    codes : (M, D) float; latent_region : (D,) int, the region of each latent dimension (a
+    local-parts network's ``latent_region``); sources : (n, R) int, for each new code and each
+    region (in increasing region number) the index of the code its dimensions come from.
+
+    Returns ``z (n, D) float64``: ``z[i]``'s dimensions of the r-th region are those of
+    ``codes[sources[i, r]]`` (what :func:`mix_parts` returns for the sources it draws).
+    """
+    Z = np.asarray(codes, dtype=np.float64)
+    labels = np.asarray(latent_region)
+    if Z.ndim != 2 or labels.shape != (Z.shape[1],) or len(Z) < 1:
+        raise ValueError(f"codes must be (M >= 1, D) and latent_region (D,), got {Z.shape} and {labels.shape}")
+    regions = np.unique(labels)
+    src = np.asarray(sources)
+    if src.ndim != 2 or src.shape[1] != len(regions) or not np.issubdtype(src.dtype, np.integer):
+        raise ValueError(f"sources must be (n, {len(regions)}) integers (one code index per region), got "
+                         f"{src.shape} {src.dtype}")
+    if src.size and (src.min() < 0 or src.max() >= len(Z)):
+        raise ValueError(f"sources must index the {len(Z)} codes, got values from {src.min()} to {src.max()}")
+    z = np.empty((len(src), Z.shape[1]))
     for r, g in enumerate(regions):  # a loop over the regions (a handful)
         cols = np.flatnonzero(labels == g)
-        z[:, cols] = Z[sources[:, r]][:, cols]
-    return z, sources
+        z[:, cols] = Z[src[:, r]][:, cols]
+    return z

@@ -224,6 +224,18 @@ def solution_names(source: str) -> list[str]:
     names bound inside functions, classes, lambdas and comprehensions (a function or class counts
     by its own name).
     """
+    names: list[str] = []
+    for match in _SOLUTION_BLOCK.finditer(source):
+        block = match.group(0)
+        for name in bound_names("\n".join(line[len(match.group(1)):] for line in block.splitlines())):
+            if name not in names:
+                names.append(name)
+    return names
+
+
+def bound_names(code: str) -> list[str]:
+    """The names a piece of code binds at module scope, in order of first binding (the rules of
+    :func:`solution_names`, for the whole code; its IPython lines are ignored)."""
     import ast
 
     names: list[str] = []
@@ -245,10 +257,85 @@ def solution_names(source: str) -> list[str]:
         for child in ast.iter_child_nodes(node):
             visit(child)
 
-    for match in _SOLUTION_BLOCK.finditer(source):
-        block = match.group(0)
-        visit(ast.parse("\n".join(line[len(match.group(1)):] for line in without_magics(block).splitlines())))
+    visit(ast.parse(without_magics(code)))
     return names
+
+
+#: the global name under which :func:`trivial_answer_notebook` hands :func:`rerun_answer` the code
+#: it ran in place of a solution: a wrong answer runs outside a cell, so the kernel's history lacks it.
+ANSWER_SOURCE = "_t_answer_source"
+
+
+def rerun_answer(namespace: dict, names, **inputs):
+    """Run the student's cell again on inputs the student has not seen, and return what it binds.
+
+    A self-check calls it to tell code from a pasted or copied answer: typed-in numbers stay the
+    same when the inputs change.
+
+    namespace : the notebook's globals (``globals()`` in the check cell); names : the answer's name,
+    or a sequence of names; inputs : the names the cell reads, given other values (``a=3, b=7``).
+
+    The student's cell is the latest cell before the running one, among those the kernel ran since
+    this module was imported (else in the kernel's history ``In``), that binds every one of ``names`` at module scope (:func:`bound_names`); it runs
+    in a copy of ``namespace`` with ``inputs`` in place, so the notebook's own names keep their
+    values (objects the cell changes in place are changed, as a rerun of the cell would). (A
+    :func:`trivial_answer_notebook` gives the code it runs in place of the solution under
+    :data:`ANSWER_SOURCE` instead.)
+
+    Returns the value of ``names`` (a str), or a tuple of values (a sequence).
+
+    Raises
+    ------
+    LookupError
+        When no earlier cell binds the names, or the rerun leaves one unbound.
+    """
+    wanted = [names] if isinstance(names, str) else list(names)
+    source = namespace.get(ANSWER_SOURCE)
+    if source is None:
+        history = (_RECORDED or list(namespace.get("In", namespace.get("_ih", []))))[:-1]   # the last is the running cell
+        source = next((cell for cell in reversed(history) if cell and set(wanted) <= set(_bound_or_none(cell))), None)
+        if source is None:
+            raise LookupError(f"no earlier cell binds {wanted}: write the answer in one cell, in terms of "
+                              f"{sorted(inputs)}, and run it")
+    scope = dict(namespace)
+    scope.update(inputs)
+    exec(source, scope)
+    missing = [n for n in wanted if n not in scope]
+    if missing:
+        raise LookupError(f"run again, the answer's cell left {missing} unbound")
+    values = tuple(scope[n] for n in wanted)
+    return values[0] if isinstance(names, str) else values
+
+
+#: the cells this IPython kernel ran since the module was imported, as Python (magics translated):
+#: the kernel's own history (``In``) stays empty where cells run without it (nbval's
+#: ``store_history=False``).
+_RECORDED: list[str] = []
+
+
+def _record_cells() -> None:
+    """Append every cell the running IPython kernel starts to :data:`_RECORDED` (once per kernel;
+    nothing outside IPython)."""
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return
+    shell = get_ipython()
+    if shell is None or getattr(shell, "_meshvae_records_cells", False):
+        return
+    shell.events.register("pre_run_cell", lambda info: _RECORDED.append(shell.transform_cell(info.raw_cell or "")))
+    shell._meshvae_records_cells = True
+
+
+_record_cells()
+
+
+def _bound_or_none(code: str) -> list[str]:
+    """:func:`bound_names` of a history entry, empty where it does not parse."""
+    try:
+        return bound_names(code)
+    except SyntaxError:
+        return []
 
 
 _TRIVIAL_CELL = '''\
@@ -278,6 +365,7 @@ for _t_answer in {answers!r} + tuple(_t_wrong):
         elif _t_answer == "zeros":
             globals()[_t_n] = _t_zero(_t_real.get(_t_n))
     _t_known = set(globals())
+    globals()[{source_name!r}] = _t_wrong.get(_t_answer, "")
     try:
         if _t_answer in _t_wrong:
             try:
@@ -293,6 +381,7 @@ for _t_answer in {answers!r} + tuple(_t_wrong):
         for _t_n in set(globals()) - _t_known:
             if not _t_n.startswith("_t_"):
                 globals().pop(_t_n, None)
+globals().pop({source_name!r}, None)
 for _t_n in _t_names:
     globals().pop(_t_n, None)
 globals().update(_t_real)
@@ -318,7 +407,9 @@ def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS, wrong_answers=None):
     before it (the solution's names back at their starting values, undefined if they had none);
     then the self-check runs as above. Names the wrong answer or the check bind that did not
     exist before are removed afterwards. A wrong answer whose own code raises is recorded as
-    ``"the wrong answer itself raised <exception>"``, not as caught.
+    ``"the wrong answer itself raised <exception>"``, not as caught. While a self-check runs, the
+    code that stands for the student's cell (the wrong answer's; ``""`` for a trivial answer, which
+    only sets the names) is under :data:`ANSWER_SOURCE`, where :func:`rerun_answer` finds it.
 
     Executing the result prints one line per exercise, ``TRIVIAL-ANSWER-OUTCOMES {"unchanged":
     "AssertionError", ..., "<wrong answer name>": "AssertionError"}``
@@ -361,7 +452,8 @@ def trivial_answer_notebook(nb, answers=TRIVIAL_ANSWERS, wrong_answers=None):
         cells.append(cell)
         check = src.cells[code_after[i]].source
         cells.append(nbformat.v4.new_code_cell(_TRIVIAL_CELL.format(names=names, check=check, answers=tuple(answers),
-                                                                  wrong=wrong, marker=TRIVIAL_MARKER)))
+                                                                  wrong=wrong, marker=TRIVIAL_MARKER,
+                                                                  source_name=ANSWER_SOURCE)))
     unknown = sorted(set(wrong_answers) - set(range(1, len(exercises) + 1)))
     if unknown:
         raise ValueError(f"wrong answers for exercises {unknown}, but the notebook has {len(exercises)} exercise(s)")

@@ -38,5 +38,22 @@ WRONG_ANSWERS = {
         'the codes averaged': (
             'hand_mixed = local.decode_latent((codes[a] + codes[b]) / 2)\n'
         ),
+        'pasted vertices of the two meshes (region 0 of a on the rest of b, nothing decoded)': (
+            'hand_mixed = train[b].copy()\n'
+            'hand_mixed[net.vertex_region.numpy() == 0] = train[a][net.vertex_region.numpy() == 0]\n'
+        ),
+        'copied from an earlier output (the right mesh for this pair, pasted as numbers)': (
+            '# the numbers do not change when the cell runs on another pair: the right mesh of meshes 0 and the\n'
+            '# farthest from it, computed elsewhere and pasted in\n'
+            'hand_mixed = np.array(local.decode_latent(np.where(net.latent_region.numpy() == 0, codes[0],\n'
+            '                      codes[int(np.argmax(np.linalg.norm(codes - codes[0], axis=1)))])).tolist())\n'
+        ),
+        'the mixed mesh of section 5 copied': (
+            'hand_mixed = mixed.copy()\n'
+        ),
+        'region 0 from a pasted onto the decoded mesh b': (
+            'hand_mixed = local.decode_latent(codes[b])\n'
+            'hand_mixed[net.vertex_region.numpy() == 0] = local.decode_latent(codes[a])[net.vertex_region.numpy() == 0]\n'
+        ),
     },
 }
