@@ -152,14 +152,17 @@ def make_jumping(seed: int = 0, resolution: int | None = None,
 def poses_dof(n: int, rng: np.random.Generator) -> tuple[Pose, np.ndarray]:
     """``n`` poses of the sixteen named joint angles of :data:`constants.POSES_DOF`, each drawn
     uniformly and independently in its range, redrawn until every pose passes the skeleton check
-    (:func:`~data_synth.motions.limb_clearance`). Returns the poses (feet planted) and their angles
+    (:func:`~data_synth.motions.limb_clearance`; at most ``POSES_MAX_DRAWS`` batches of n, then
+    RuntimeError). Returns the poses (feet planted) and their angles
     ``(n, 16) float64`` in the order of ``POSES_DOF``."""
     if n < 1:
         raise ValueError(f"n must be at least 1, got {n}")
     names = list(C.POSES_DOF)
     low, high = np.array([C.POSES_DOF[k] for k in names]).T
     local, angles = [], []
-    while sum(len(a) for a in angles) < n:
+    for _ in range(C.POSES_MAX_DRAWS):
+        if sum(len(a) for a in angles) >= n:
+            break
         a = rng.uniform(low, high, size=(n, len(names)))
         d = dict(zip(names, a.T))
         pose = Pose.identity(n)
@@ -172,6 +175,10 @@ def poses_dof(n: int, rng: np.random.Generator) -> tuple[Pose, np.ndarray]:
         keep = np.flatnonzero(limb_clearance(pose) >= 0.0)
         local.append(pose.local[keep])
         angles.append(a[keep])
+    kept = sum(len(a) for a in angles)
+    if kept < n:
+        raise RuntimeError(f"only {kept} of {C.POSES_MAX_DRAWS * n} poses drawn in POSES_DOF's ranges pass the"
+                           f" skeleton check, {n} were asked for: the ranges put limbs through the body")
     local = np.concatenate(local)[:n]
     return Pose(local, np.zeros((n, 3)), plant=("l_foot", "r_foot")), np.concatenate(angles)[:n]
 

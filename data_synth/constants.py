@@ -180,6 +180,8 @@ BAR_PROFILE_CLIP = 1.6
 #: angles: four per arm (lower from the A-pose, swing forward, twist, elbow), two per leg (hip,
 #: knee), and the trunk's bend and twist with the head's nod and turn.
 POSES_N = 1200
+#: poses_dof draws at most this many batches of n poses; ranges that reject nearly every pose fail loudly.
+POSES_MAX_DRAWS = 20
 POSES_DOF = {
     "l_arm_lower": (-0.9, 0.25), "l_arm_forward": (-0.3, 0.9), "l_arm_twist": (-0.6, 0.6), "l_elbow": (0.0, 1.6),
     "r_arm_lower": (-0.9, 0.25), "r_arm_forward": (-0.3, 0.9), "r_arm_twist": (-0.6, 0.6), "r_elbow": (0.0, 1.6),

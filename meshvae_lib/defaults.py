@@ -199,3 +199,5 @@ CORRECTION_MIN_GAIN = 0.02
 CORRECTION_CONFIDENCE = 0.975
 CORRECTION_RANK = 128
 CORRECTION_FIT_ITERATIONS = 60
+#: the fewest validation rows that choose between the corrected and the linear decoder (fewer: linear).
+CORRECTION_MIN_CHOICE_ROWS = 3

@@ -190,6 +190,11 @@ MAX_ABS_COORDINATE = 1e40
 #: rows of a tanh output are clipped into [-TANH_ROW_CLIP, TANH_ROW_CLIP] before ``atanh`` where only a
 #: start is needed (``corrected_decoder``: the projection that starts a code's fit through the tanh).
 TANH_ROW_CLIP = 0.999
+#: L-BFGS stopping rules of the corrected decoder's code fits (torch's defaults are 1e-7 and 1e-9):
+#: all rows are fitted at once, so the fit stops only where every row's code has converged, and a
+#: row's code does not depend on the rows fitted beside it (to 1e-6; torch's defaults: 5e-5).
+CODE_FIT_GRAD_TOL = 1e-10
+CODE_FIT_CHANGE_TOL = 1e-14
 #: principal directions computed through the Gram matrix (``corrected_decoder.principal_directions``)
 #: whose singular value is below this fraction of the largest are numerical noise (the Gram matrix
 #: squares the condition number: rounding leaves singular values near sqrt(eps) = 1.5e-8 of the largest).

@@ -69,16 +69,27 @@ def test_the_correction_pays_on_a_curved_set_and_never_on_noise():
 
 
 def test_the_correction_starts_at_zero_so_training_starts_at_the_linear_optimum():
-    Y = torus_rows(120, seed=0)
-    m = CorrectedLinearDecoder(4, seed=0)
-    m._check_params()
-    net = m._network(4, 8)
+    """The correction network's last layer starts at zero: before any step, the corrected decoder
+    decodes every code exactly as the linear one does."""
     import torch
 
-    z = torch.randn(7, 4, dtype=torch.float64)
-    s = torch.ones(4, dtype=torch.float64)
-    np.testing.assert_array_equal(m._decode_coeff(net, z, s, 8).detach().numpy(), m._decode_coeff(None, z, s, 8).numpy())
-    assert Y.shape == (120, 40)
+    m = CorrectedLinearDecoder(4, seed=0)
+    net = m._network(4, 8)
+    z = torch.randn(7, 4, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
+    s = torch.linspace(1.0, 0.5, 4, dtype=torch.float64)
+    corrected, linear = m._decode_coeff(net, z, s, 8).detach().numpy(), m._decode_coeff(None, z, s, 8).numpy()
+    np.testing.assert_array_equal(corrected, linear)
+    assert np.abs(linear).max() > 0.1  # not trivially zero
+
+
+def test_fitting_leaves_the_callers_random_state_alone():
+    import torch
+
+    torch.manual_seed(123)
+    expected = torch.rand(3)
+    torch.manual_seed(123)
+    CorrectedLinearDecoder(3, seed=9, hidden=(16,), max_steps=60, check_every=20).fit(torus_rows(60, seed=0))
+    np.testing.assert_array_equal(torch.rand(3).numpy(), expected.numpy())
 
 
 def test_a_few_lucky_validation_rows_do_not_choose_the_correction():
@@ -115,17 +126,46 @@ def test_deterministic_for_a_seed():
 
 
 def test_the_score_chooses():
-    """A score that calls the corrected reconstructions worse makes the estimator keep the linear one."""
-    Y = torus_rows(400, seed=0)
+    """The same fit that keeps the correction on the squared error (the curved-set test) keeps the
+    linear decoder when the score calls better reconstructions worse: the choice follows ``score``,
+    measured on the 30 choosing rows only, for both decoders."""
+    Y = torus_rows(300, seed=0)
     seen = []
 
-    def score(rows, idx):
-        seen.append(len(idx))
-        lin = projection(Y[np.setdiff1d(np.arange(len(Y)), idx)], Y[idx], 4)
-        return np.where(np.allclose(rows, lin, atol=1e-6), 1.0, 2.0) * np.ones(len(idx))
+    def inverted(rows, idx):
+        seen.append(np.array(idx))
+        return 1.0 / (1e-3 + np.sum((rows - Y[idx]) ** 2, axis=1))
 
-    m = CorrectedLinearDecoder(4, seed=0, hidden=(64, 64), max_steps=300).fit(Y, score=score)
-    assert m.kept_ == "linear" and len(seen) == 2 and seen[0] == seen[1] == 40
+    m = CorrectedLinearDecoder(4, seed=0, **FAST).fit(Y, score=inverted)
+    assert m.kept_ == "linear", m.report_.reason
+    assert m.report_.corrected_score > m.report_.linear_score  # inverted: the correction reconstructs better
+    assert len(seen) == 2 and len(seen[0]) == 30
+    np.testing.assert_array_equal(seen[0], seen[1])
+    np.testing.assert_array_equal(seen[0], np.arange(300)[2::5][1::2])  # every 5th from the 2nd, alternate ones
+    with pytest.raises(ValueError, match=r"score must return \(30,\) finite errors, got shape \(1,\)"):
+        CorrectedLinearDecoder(4, seed=0, hidden=(16,), max_steps=100).fit(Y, score=lambda rows, idx: np.ones(1))
+
+
+def test_tanh_codes_do_not_depend_on_the_rows_beside_them_and_the_correction_pays_through_the_tanh():
+    """A tanh output (normalised RIMD rows): each row's code is the same fitted alone or in a batch
+    (within 2e-6: the fit's unit is the training rows' spread, and it runs to convergence), with the
+    linear and with the corrected decoder; on a curved set the correction is kept and reconstructs
+    new rows better than the linear decoder through the tanh."""
+    Y, Y_new = torus_rows(300, seed=0, K=20), torus_rows(60, seed=1, K=20)
+    scale = np.abs(Y).max()
+    X, X_new = np.tanh(0.4 * Y / scale), np.tanh(0.4 * Y_new / scale)
+    linear = CorrectedLinearDecoder(3, output="tanh").fit_linear(X)
+    corrected = CorrectedLinearDecoder(3, output="tanh", seed=0, **FAST).fit(X)
+    assert corrected.kept_ == "corrected", corrected.report_.reason
+    for m in (linear, corrected):
+        batch = m.codes(X_new[:8])
+        alone = np.concatenate([m.codes(X_new[i:i + 1]) for i in range(8)])
+        np.testing.assert_allclose(alone, batch, atol=2e-6)
+    err = np.mean(np.sum((corrected.reconstruct(X_new) - X_new) ** 2, axis=1))
+    lin = np.mean(np.sum((linear.reconstruct(X_new) - X_new) ** 2, axis=1))
+    assert err < 0.5 * lin, (err, lin)
+    with pytest.raises(ValueError, match="rows of a tanh output must lie in \\[-1, 1\\], got a value of 1.5"):
+        linear.codes(np.full((1, 20), 1.5))
 
 
 @pytest.mark.parametrize("kwargs, match", [

@@ -237,3 +237,13 @@ def test_poses_are_rebuilt_from_their_angles():
         poses_dof(0, rng)
     with pytest.raises(ValueError, match="n_poses must be an integer >= 2, got 1"):
         COLLECTIONS["poses"].build(seed=0, n_poses=1)
+
+
+def test_poses_whose_ranges_reject_every_pose_fail_after_a_bounded_number_of_draws(monkeypatch):
+    """Ranges that put every arm through the body would make the redraw loop endless: after
+    POSES_MAX_DRAWS batches it raises, saying how many poses passed."""
+    import data_synth.bodies as bodies
+
+    monkeypatch.setattr(bodies, "limb_clearance", lambda pose: np.full(len(pose.local), -1.0))
+    with pytest.raises(RuntimeError, match=rf"only 0 of {C.POSES_MAX_DRAWS * 7} poses .* 7 were asked for"):
+        bodies.poses_dof(7, np.random.default_rng(0))

@@ -31,20 +31,17 @@ import logging
 import numpy as np
 
 from meshvae_lib.defaults import (CORRECTION_CHECK_EVERY, CORRECTION_CODE_PRIOR, CORRECTION_CONFIDENCE, CORRECTION_FIT_ITERATIONS,
-                                  CORRECTION_HIDDEN, CORRECTION_LR, CORRECTION_MAX_STEPS, CORRECTION_MIN_GAIN,
+                                  CORRECTION_HIDDEN, CORRECTION_LR, CORRECTION_MAX_STEPS, CORRECTION_MIN_CHOICE_ROWS, CORRECTION_MIN_GAIN,
                                   CORRECTION_PATIENCE, CORRECTION_RANK, CORRECTION_VALIDATION_EVERY,
                                   CORRECTION_WEIGHT_DECAY)
-from meshvae_lib.model.correction_choice import CorrectionReport, gain_lower_bound
+from meshvae_lib.model.correction_choice import CorrectionReport, checked_scores, gain_lower_bound
 from meshvae_lib.model.gram_pca import principal_directions
-from meshvae_lib.tolerances import TANH_ROW_CLIP
+from meshvae_lib.tolerances import CODE_FIT_CHANGE_TOL, CODE_FIT_GRAD_TOL, TANH_ROW_CLIP
 from meshvae_lib.validation import check_is_fitted
 
 __all__ = ["CorrectedLinearDecoder"]
 
 log = logging.getLogger(__name__)
-
-#: the fewest validation rows that choose between the corrected and the linear decoder (fewer: linear).
-MIN_CHOICE_ROWS = 3
 
 
 class CorrectedLinearDecoder:
@@ -78,7 +75,8 @@ class CorrectedLinearDecoder:
 
     Attributes (after ``fit``)
     --------------------------
-    mean_ : (K,) float64; basis_ : (r, K) float64, orthonormal rows; scale_ : (r,) float64;
+    mean_ : (K,) float64; basis_ : (r, K) float64, orthonormal rows; scale_ : (r,) float64; spread_ :
+    float, the training rows' mean squared distance from their mean;
     correction_ : the torch module g (None when the linear decoder was kept); report_ :
     :class:`CorrectionReport`; n_features_in_ : K.
     """
@@ -118,13 +116,15 @@ class CorrectedLinearDecoder:
         if not 0.0 <= float(self.min_gain) < 1.0:
             raise ValueError(f"min_gain must lie in [0, 1), got {self.min_gain!r}")
 
-    @staticmethod
-    def _rows(Y, what: str = "Y") -> np.ndarray:
+    def _rows(self, Y, what: str = "Y", outputs: bool = True) -> np.ndarray:
+        """``Y`` as float64 (M, K), checked: finite, and for a tanh output (``outputs``) within [-1, 1]."""
         Y = np.asarray(Y, dtype=np.float64)
         if Y.ndim != 2 or Y.shape[0] < 1 or Y.shape[1] < 1:
             raise ValueError(f"{what} must be (n_rows, n_features), got shape {Y.shape}")
         if not np.isfinite(Y).all():
             raise ValueError(f"{what} has {int((~np.isfinite(Y)).sum())} non-finite values")
+        if outputs and self.output == "tanh" and np.abs(Y).max() > 1.0:
+            raise ValueError(f"{what}: rows of a tanh output must lie in [-1, 1], got a value of {np.abs(Y).max():.6g}")
         return Y
 
     # -- fitting -----------------------------------------------------------------------------------
@@ -142,7 +142,7 @@ class CorrectedLinearDecoder:
         n, D = len(X), int(self.latent_dim)
         if n < D + 2:
             raise ValueError(f"need at least latent_dim + 2 = {D + 2} training rows, got {n}")
-        self.n_features_in_ = X.shape[1]
+        self.n_features_in_, self.spread_ = X.shape[1], self._spread(X)
         Y = self._pre(X)
         k = int(self.validation_every)
         val = np.zeros(n, dtype=bool)
@@ -154,7 +154,7 @@ class CorrectedLinearDecoder:
         choose[np.flatnonzero(val)[1::2]] = True
         n_fit, n_val = int((~val).sum()), int(val.sum())
         none = dict(linear_validation=float("nan"), corrected_validation=float("nan"), best_step=0, steps=0)
-        if n_fit < D + 2 or choose.sum() < MIN_CHOICE_ROWS:
+        if n_fit < D + 2 or choose.sum() < CORRECTION_MIN_CHOICE_ROWS:
             self._keep_linear(Y, CorrectionReport(
                 "linear", f"too few rows ({n}) to set every {k}-th aside for validation", **none,
                 n_fit=n, n_validation=0, curve=[]))
@@ -191,8 +191,7 @@ class CorrectedLinearDecoder:
             e_lin = np.sum((linear_rows - X[choose]) ** 2, axis=1)
             e_cor = np.sum((corrected_rows - X[choose]) ** 2, axis=1)
         else:
-            e_lin = np.asarray(score(linear_rows, idx), dtype=np.float64).reshape(-1)
-            e_cor = np.asarray(score(corrected_rows, idx), dtype=np.float64).reshape(-1)
+            e_lin, e_cor = (checked_scores(score, rows, idx) for rows in (linear_rows, corrected_rows))
         gain = e_lin - e_cor
         bound = gain_lower_bound(gain, float(self.confidence))
         report.update(linear_score=float(e_lin.mean()), corrected_score=float(e_cor.mean()), gain_lower_bound=bound,
@@ -213,7 +212,7 @@ class CorrectedLinearDecoder:
         linear floor of the same capacity, with codes fitted as :meth:`codes` fits them. Returns self."""
         self._check_params()
         X = self._rows(X)
-        self.n_features_in_ = X.shape[1]
+        self.n_features_in_, self.spread_ = X.shape[1], self._spread(X)
         self._keep_linear(self._pre(X), CorrectionReport(
             "linear", "fit_linear: no correction trained", float("nan"), float("nan"), 0, 0, len(X), 0, []))
         return self
@@ -227,8 +226,9 @@ class CorrectedLinearDecoder:
 
         D, r = int(self.latent_dim), C_fit.shape[1]
         s = torch.tensor(scale[:D] / unit, dtype=torch.float64)
-        torch.manual_seed(int(self.seed))
-        net = self._network(D, r)
+        with torch.random.fork_rng(devices=[]):  # the seed sets this network, not the caller's RNG
+            torch.manual_seed(int(self.seed))
+            net = self._network(D, r)
         Ct = torch.tensor(C_fit)
         Z = torch.tensor(C_fit[:, :D] / (scale[:D] / unit), requires_grad=True)
         opt = torch.optim.AdamW([{"params": net.parameters(), "weight_decay": float(self.weight_decay)},
@@ -255,6 +255,12 @@ class CorrectedLinearDecoder:
                     if since >= int(self.patience):
                         break
         return net, best, best_step, best_state, step, curve
+
+    @staticmethod
+    def _spread(X: np.ndarray) -> float:
+        """The training rows' mean squared distance from their mean (1 where they are all equal): the
+        unit of a tanh output's code fit, so that a row's code does not depend on the rows beside it."""
+        return float(np.mean(np.sum((X - X.mean(0)) ** 2, axis=1))) or 1.0
 
     def _pre(self, X: np.ndarray) -> np.ndarray:
         """The rows' pre-activations: ``atanh`` of rows clipped into (-1, 1) for a tanh output."""
@@ -298,7 +304,8 @@ class CorrectedLinearDecoder:
         z = (C[:, :D] / s).clone().requires_grad_(True)
         if net is None:
             return z.detach()
-        opt = torch.optim.LBFGS([z], lr=1.0, max_iter=int(self.fit_iterations), line_search_fn="strong_wolfe")
+        opt = torch.optim.LBFGS([z], lr=1.0, max_iter=int(self.fit_iterations), line_search_fn="strong_wolfe",
+                                tolerance_grad=CODE_FIT_GRAD_TOL, tolerance_change=CODE_FIT_CHANGE_TOL)
 
         def closure():
             opt.zero_grad()
@@ -326,16 +333,17 @@ class CorrectedLinearDecoder:
 
     def _fit_output_codes(self, z0, X, s, r: int):
         """Codes that fit rows ``X (M, K)`` through the tanh: L-BFGS on ``|tanh(decoded) - X|^2``
-        relative to the rows' spread, from ``z0``, plus the code penalty where the correction is
+        relative to the training rows' spread (``spread_``), from ``z0``, plus the code penalty where the correction is
         kept (the linear decoder's fit is plain least squares, as its projection is for coordinates)."""
         import torch
 
         mean, basis = torch.tensor(self.mean_), torch.tensor(self.basis_ * self._unit)
         D = z0.shape[1]
         prior = 0.0 if self.correction_ is None else float(self.code_prior)  # the linear decoder: least squares
-        spread = float(torch.mean(torch.sum((X - X.mean(0)) ** 2, dim=1))) or 1.0
+        spread = self.spread_
         z = z0.clone().requires_grad_(True)
-        opt = torch.optim.LBFGS([z], lr=1.0, max_iter=int(self.fit_iterations), line_search_fn="strong_wolfe")
+        opt = torch.optim.LBFGS([z], lr=1.0, max_iter=int(self.fit_iterations), line_search_fn="strong_wolfe",
+                                tolerance_grad=CODE_FIT_GRAD_TOL, tolerance_change=CODE_FIT_CHANGE_TOL)
 
         def closure():
             opt.zero_grad()
@@ -369,7 +377,7 @@ class CorrectedLinearDecoder:
         import torch
 
         check_is_fitted(self, "report_")
-        Z = self._rows(Z, "Z")
+        Z = self._rows(Z, "Z", outputs=False)
         D = int(self.latent_dim)
         if Z.shape[1] != D:
             raise ValueError(f"codes must have {D} components, got {Z.shape[1]}")

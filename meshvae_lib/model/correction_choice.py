@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["CorrectionReport", "gain_lower_bound"]
+__all__ = ["CorrectionReport", "checked_scores", "gain_lower_bound"]
 
 
 def gain_lower_bound(gain: np.ndarray, confidence: float) -> float:
@@ -19,6 +19,16 @@ def gain_lower_bound(gain: np.ndarray, confidence: float) -> float:
     if gain.size < 2:
         raise ValueError(f"need at least 2 gains for a bound, got {gain.size}")
     return float(gain.mean() - t.ppf(confidence, gain.size - 1) * gain.std(ddof=1) / np.sqrt(gain.size))
+
+
+def checked_scores(score, rows: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """``score(rows, idx)`` (the caller's error of each reconstruction ``rows (M, K)`` of the rows
+    ``idx (M,)``), checked: (M,) finite float64, else ValueError showing what came back."""
+    e = np.asarray(score(rows, idx), dtype=np.float64)
+    if e.shape != (len(idx),) or not np.isfinite(e).all():
+        raise ValueError(f"score must return ({len(idx)},) finite errors, got shape {e.shape}"
+                         f" with {int((~np.isfinite(e)).sum()) if e.size else 0} non-finite values")
+    return e
 
 
 @dataclass

@@ -70,9 +70,8 @@ class MeshVAEModel:
     sigma_object_ : (D,) float64 deviations of the prior :meth:`sample_latent` draws from: the
         config's sigma_object with the exact prior form, ones for the standard prior and the
         sibling form (whose latent cost keeps the means' unit spread).
-    holdout_mask_ : (N,) bool, which meshes of the training collection were held out; ``mesh_fingerprints_``:
-        (N, 17) float64, their identities (:func:`~meshvae_lib.geometry.collection.mesh_fingerprints`;
-        None: format 3).
+    holdout_mask_ : (N,) bool, the held-out meshes; ``mesh_fingerprints_`` : (N, 17) float64, every
+        mesh's identity (:func:`~meshvae_lib.geometry.collection.mesh_fingerprints`; None: format 3).
     train_config_ : TrainConfig the network was trained with (``config`` or the defaults, resolved once
         by ``TrainConfig.resolve``; written into the checkpoint; ``config`` itself is left as given).
     history_ : list of per-epoch dicts (see :class:`~meshvae_lib.model.training.TrainResult`); train_seconds_ : float.
@@ -319,8 +318,7 @@ class MeshVAEModel:
                 "layout": self.layout, "reference_index": int(self.reference_index), "inference": inference}
 
     def state_dict(self) -> dict:
-        """Everything that makes up the fitted model (arrays, tensors, numbers, strings, lists, dicts): what
-        :mod:`~meshvae_lib.model.checkpoint` stores (``mesh_fingerprints`` too, so that its checks cover them)."""
+        """The fitted model, all of it (arrays, tensors, numbers, strings, lists, dicts): what the checkpoint stores."""
         net = self._fitted().network_
         return {
             "architecture": net.architecture,
