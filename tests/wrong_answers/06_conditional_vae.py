@@ -16,6 +16,7 @@ WRONG_ANSWERS = {
             'conditioned=False, dataset_features=X)\n'),
         'the shape column instead of the motion': (
             'per_motion = generation.condition_agreement(cond, coll, "shape", n=N_PER_LABEL, seed=SEED, dataset_features=X)\n'),
+        "copied from an earlier output (section 5's data meshes, 0.79)": 'per_motion = np.full(len(motions), 0.79)\n',
     },
     2: {
         'each mesh is its own nearest neighbour': (
@@ -27,6 +28,7 @@ WRONG_ANSWERS = {
             + 'share_plain = float(np.mean(coll.labels["shape"][generation.nearest_neighbors(Zc, Zc, exclude_self=True)[0]] == coll.labels["shape"]))\n'
             'share_cond = float(np.mean(coll.labels["shape"][generation.nearest_neighbors(Zp, Zp, exclude_self=True)[0]] == coll.labels["shape"]))\n'),
         'chance for both': 'share_cond = share_plain = 1 / len(shapes)\n',
+        'copied from an earlier output (the shares 0.15 and 0.55 the check once printed)': 'share_cond, share_plain = 0.15, 0.55\n',
     },
     3: {
         'the naive guess w = 0.5': 'w_mid = 0.5\n',
