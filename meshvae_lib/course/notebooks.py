@@ -296,7 +296,7 @@ def rerun_answer(namespace: dict, names, **inputs):
         source = next((cell for cell in reversed(history) if cell and set(wanted) <= set(_bound_or_none(cell))), None)
         if source is None:
             raise LookupError(f"no earlier cell binds {wanted}: write the answer in one cell, in terms of "
-                              f"{sorted(inputs)}, and run it")
+                              f"{sorted(inputs)}, and run it (after the lesson's first cell, which calls record_cells())")
     scope = dict(namespace)
     scope.update(inputs)
     exec(source, scope)
@@ -313,9 +313,11 @@ def rerun_answer(namespace: dict, names, **inputs):
 _RECORDED: list[str] = []
 
 
-def _record_cells() -> None:
-    """Append every cell the running IPython kernel starts to :data:`_RECORDED` (once per kernel;
-    nothing outside IPython)."""
+def record_cells() -> None:
+    """Record every cell the running IPython kernel starts from now on (in :data:`_RECORDED`), so
+    that :func:`rerun_answer` finds a student's cell where the kernel keeps no history (nbval).
+    A lesson whose self-checks rerun answers calls it in its first cell; calling it again, or
+    outside IPython, does nothing."""
     try:
         from IPython import get_ipython
     except ImportError:
@@ -326,8 +328,6 @@ def _record_cells() -> None:
     shell.events.register("pre_run_cell", lambda info: _RECORDED.append(shell.transform_cell(info.raw_cell or "")))
     shell._meshvae_records_cells = True
 
-
-_record_cells()
 
 
 def _bound_or_none(code: str) -> list[str]:
