@@ -18,6 +18,12 @@ WRONG_ANSWERS = {
             'T_after = Q @ T_before\n'
             'rigid_err = 0.0\n'
         ),
+        'rigid_err typed in from the failure message': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before, T_after = op(V1), op(V_moved)\n'
+            'rigid_err = 1e-13\n'
+        ),
     },
     2: {
         'library weights typed in from the printout': (
@@ -49,6 +55,11 @@ WRONG_ANSWERS = {
         'a folded pair: both apexes on the same side of the edge': (
             'P3 = np.array([[0.0, 0, 0], [2.0, 0, 0], [1.0, 0.05, 0], [1.0, 0.1, 0]])\n'
             'T3 = np.array([[0, 1, 2], [1, 0, 3]])\n'
+            'c_neg = float(cotangent_weights(P3, T3, clamp=False)[edge_index(edges(T3), 0, 1)])\n'
+        ),
+        'a folded pair whose faces are listed so that their normals agree': (
+            'P3 = np.array([[0.0, 0, 0], [2.0, 0, 0], [1.0, 0.05, 0], [1.0, 0.1, 0]])\n'
+            'T3 = np.array([[0, 1, 2], [0, 1, 3]])\n'
             'c_neg = float(cotangent_weights(P3, T3, clamp=False)[edge_index(edges(T3), 0, 1)])\n'
         ),
         'a weight below -5 typed in for a pair that does not have it': (
