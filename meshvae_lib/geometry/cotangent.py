@@ -11,7 +11,7 @@ term of the deformation gradient (``NORMAL_EDGE_WEIGHT``, expressed in units of 
 Robustness (``clamp=True``, the default, with the reference's thresholds from
 :mod:`meshvae_lib.tolerances`):
 
-- obtuse triangles make ``c_ij`` negative (both opposite angles obtuse) and sliver triangles make it
+- obtuse triangles make ``c_ij`` negative (when the two opposite angles sum past pi) and sliver triangles make it
   huge; values below ``COT_WEIGHT_MIN`` are raised to it, and NaN or values above
   ``COT_WEIGHT_MAX`` are replaced by ``COT_WEIGHT_FALLBACK``;
 - a boundary edge has one opposite angle only: ``c_ij = cot(alpha_ij)``;
@@ -67,7 +67,7 @@ def cotangent_weights(V, F, clamp: bool = True, topology: MeshTopology | None = 
     F : (n_faces, 3) int
     clamp : bool
         Apply the reference implementation's safeguards (see the module docstring). With
-        ``clamp=False`` the raw sums are returned (negative for obtuse pairs, ``inf``/NaN next to
+        ``clamp=False`` the raw sums are returned (negative where the opposite angles sum past pi, ``inf``/NaN next to
         zero-area faces).
 
     Returns
