@@ -116,15 +116,16 @@ class CorrectedLinearDecoder:
         if not 0.0 <= float(self.min_gain) < 1.0:
             raise ValueError(f"min_gain must lie in [0, 1), got {self.min_gain!r}")
 
-    def _rows(self, Y, what: str = "Y", outputs: bool = True) -> np.ndarray:
-        """``Y`` as float64 (M, K), checked: finite, and for a tanh output (``outputs``) within [-1, 1]."""
+    def _rows(self, Y, what: str = "Y", training: bool = False) -> np.ndarray:
+        """``Y`` as float64 (M, K), checked: finite, and training rows of a tanh output within [-1, 1]
+        (held-out rows, normalised with the training range, may lie beyond: they are clipped)."""
         Y = np.asarray(Y, dtype=np.float64)
         if Y.ndim != 2 or Y.shape[0] < 1 or Y.shape[1] < 1:
             raise ValueError(f"{what} must be (n_rows, n_features), got shape {Y.shape}")
         if not np.isfinite(Y).all():
             raise ValueError(f"{what} has {int((~np.isfinite(Y)).sum())} non-finite values")
-        if outputs and self.output == "tanh" and np.abs(Y).max() > 1.0:
-            raise ValueError(f"{what}: rows of a tanh output must lie in [-1, 1], got a value of {np.abs(Y).max():.6g}")
+        if training and self.output == "tanh" and np.abs(Y).max() > 1.0:
+            raise ValueError(f"{what}: training rows of a tanh output must lie in [-1, 1], got a value of {np.abs(Y).max():.6g}")
         return Y
 
     # -- fitting -----------------------------------------------------------------------------------
@@ -138,7 +139,7 @@ class CorrectedLinearDecoder:
             choice between the corrected and the linear decoder follows ``score``.
         """
         self._check_params()
-        X = self._rows(X)
+        X = self._rows(X, training=True)
         n, D = len(X), int(self.latent_dim)
         if n < D + 2:
             raise ValueError(f"need at least latent_dim + 2 = {D + 2} training rows, got {n}")
@@ -211,7 +212,7 @@ class CorrectedLinearDecoder:
         """Fit the linear decoder alone (what :meth:`fit` falls back to) on rows ``X (N, K)``: the
         linear floor of the same capacity, with codes fitted as :meth:`codes` fits them. Returns self."""
         self._check_params()
-        X = self._rows(X)
+        X = self._rows(X, training=True)
         self.n_features_in_, self.spread_ = X.shape[1], self._spread(X)
         self._keep_linear(self._pre(X), CorrectionReport(
             "linear", "fit_linear: no correction trained", float("nan"), float("nan"), 0, 0, len(X), 0, []))
@@ -365,7 +366,8 @@ class CorrectedLinearDecoder:
     def codes(self, X) -> np.ndarray:
         """Whitened codes ``(M, D)`` float64 of rows ``X (M, K)``: the projection of their
         pre-activations onto the D principal directions, refined through the correction where it was
-        kept, and for a tanh output fitted to the rows themselves through the tanh."""
+        kept, and for a tanh output fitted to the rows themselves through the tanh (held-out rows
+        beyond [-1, 1] are clipped to ``TANH_ROW_CLIP`` for the projection only)."""
         check_is_fitted(self, "report_")
         X = self._rows(X, "X")
         if X.shape[1] != self.n_features_in_:
@@ -377,7 +379,7 @@ class CorrectedLinearDecoder:
         import torch
 
         check_is_fitted(self, "report_")
-        Z = self._rows(Z, "Z", outputs=False)
+        Z = self._rows(Z, "Z")
         D = int(self.latent_dim)
         if Z.shape[1] != D:
             raise ValueError(f"codes must have {D} components, got {Z.shape[1]}")
