@@ -55,5 +55,12 @@ WRONG_ANSWERS = {
             'hand_mixed = local.decode_latent(codes[b])\n'
             'hand_mixed[net.vertex_region.numpy() == 0] = local.decode_latent(codes[a])[net.vertex_region.numpy() == 0]\n'
         ),
+        'the forbidden library call (parts_code builds the mix)': (
+            'hand_mixed = local.decode_latent(parts_code(codes, net.latent_region.numpy(), [[a] + [b] * (REGIONS - 1)]))[0]\n'
+        ),
+        'the forbidden library call, imported again under another name': (
+            'from meshvae_lib.applications.generation import parts_code as mix_by_regions\n'
+            'hand_mixed = local.decode_latent(mix_by_regions(codes, net.latent_region.numpy(), [[a] + [b] * (REGIONS - 1)]))[0]\n'
+        ),
     },
 }
