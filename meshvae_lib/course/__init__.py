@@ -14,7 +14,7 @@ EXPORTS = exports_of(__name__, """
 display      describe_model first_argmax local_parts_figure local_parts_table model_summary roundoff
 display      real_feature_table real_inference_table span_ceiling_table spiral_figure spiral_table
 models       course_model get_spec
-notebooks    record_cells rerun_answer
+answer_rerun record_cells rerun_answer
 prior_costs  one_dimension_cost prior_cost_figure
 """)
 
