@@ -91,7 +91,7 @@ def rerun_answer(namespace: dict, names, **inputs):
     return values[0] if isinstance(names, str) else values
 
 
-#: the cells this IPython kernel ran since the module was imported, as Python (magics translated):
+#: the cells this IPython kernel ran since :func:`record_cells` was called, as Python (magics translated):
 #: the kernel's own history (``In``) stays empty where cells run without it (nbval's
 #: ``store_history=False``).
 _RECORDED: list[str] = []
@@ -111,7 +111,6 @@ def record_cells() -> None:
         return
     shell.events.register("pre_run_cell", lambda info: _RECORDED.append(shell.transform_cell(info.raw_cell or "")))
     shell._meshvae_records_cells = True
-
 
 
 def _bound_or_none(code: str) -> list[str]:
