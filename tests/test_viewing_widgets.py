@@ -326,6 +326,17 @@ def test_a_static_page_shows_the_explorers_slider_extremes(sphere):
     assert w >= 3 * 150 and h >= 4 * 150, f"a 4 x 3 grid of readable panels, got {w}x{h} px"
 
 
+def test_the_explorers_static_panels_take_the_size_asked_for(sphere):
+    from meshvae_lib.defaults import STATIC_DPI
+
+    V, F = sphere
+    ex = LatentExplorer(LinearDecoder(V, 4), 4, F, mode="threejs", static_size=2.5)
+    w, h = _png_size(ex.static_png())
+    assert w >= 3 * 2.5 * STATIC_DPI - 20 and h >= 4 * 2.5 * STATIC_DPI, f"4 x 3 panels of 2.5 inches, got {w}x{h} px"
+    with pytest.raises(ValueError, match="static_size"):
+        LatentExplorer(LinearDecoder(V, 4), 4, F, mode="threejs", static_size=0)
+
+
 def test_a_static_page_shows_the_interpolation_along_t(sphere):
     V, F = sphere
     seen = []

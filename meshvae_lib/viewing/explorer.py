@@ -73,6 +73,9 @@ class LatentExplorer(_Displayable):
         :data:`~meshvae_lib.defaults.LIVE_UPDATE_MAX_MS`, so a slow model does not build a
         backlog of stale slider positions.
     titles : list of str, optional
+    static_size : float
+        Inches per panel of :meth:`static_png`, the picture a page without widgets shows
+        (default ``defaults.STATIC_PANEL_INCHES``).
     **viewer_kw
         Passed to :class:`MeshViewer` (``width``, ``height``, ``mode``, ...).
 
@@ -89,8 +92,11 @@ class LatentExplorer(_Displayable):
     def __init__(self, decode, latent_dim: int, F, dims=None, z0=None, value_range=EXPLORATION_RANGE,
                  step: float = 0.05, pad_dims="auto", pad_event: str = "click", seed: int = 0,
                  random_scale=1.0, random_mean=None, reference=None, color_by=None, continuous_update="auto",
-                 titles=None, **viewer_kw):
+                 titles=None, static_size: float = STATIC_PANEL_INCHES, **viewer_kw):
         self._decode = _as_decoder(decode)
+        if not static_size > 0:
+            raise ValueError(f"static_size must be positive, got {static_size}")
+        self.static_size = float(static_size)
         self.latent_dim = check_count(latent_dim, "latent_dim", minimum=1)
         self.dims = self._checked_dims(dims)
         self.ranges = self._checked_ranges(value_range)
@@ -261,7 +267,7 @@ class LatentExplorer(_Displayable):
                 titles.append(f"z[{d}] = {v:+.1f}")
         self.n_decodes = count                      # a picture, not a slider move
         return figure_to_png(render_mesh_grid(meshes, self.viewer.F, titles=titles, ncols=3,
-                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
+                                              size=self.static_size, dpi=STATIC_DPI))
 
     # -- decoding ------------------------------------------------------------------------------
     def _decode_meshes(self, z) -> np.ndarray:
