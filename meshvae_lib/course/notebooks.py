@@ -146,9 +146,9 @@ def execute_notebook(path: Path, timeout: int = 600, kernel_name: str = "python3
         every vertex buffer (megabytes) and an HTML export of it needs the three.js widget code
         from a CDN; without it each view exports as the PNG snapshot the viewer stores beside it.
         ``None`` (the default) does what the notebook asks in its metadata
-        (``"meshvae": {"store_widget_state": true}``: notebook 00, whose state is small enough to
-        keep), else stores nothing; without state, any state an earlier run left is removed, since
-        it would describe widgets that no output shows any more.
+        (``"meshvae": {"store_widget_state": true}``: notebooks 00, 05 and 08, whose state is small
+        enough to keep), else stores nothing; without state, any state an earlier run left is
+        removed, since it would describe widgets that no output shows any more.
     parameters : dict of str to str, optional
         Overrides of the parameters cell (see :func:`inject_parameters`).
     """
