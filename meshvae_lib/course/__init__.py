@@ -15,6 +15,7 @@ display      describe_model first_argmax local_parts_figure local_parts_table mo
 display      real_feature_table real_inference_table span_ceiling_table spiral_figure spiral_table
 models       course_model get_spec
 answer_rerun record_cells rerun_answer
+gradient_fits gradient_fit_stats
 prior_costs  one_dimension_cost prior_cost_figure
 """)
 

@@ -24,22 +24,50 @@ WRONG_ANSWERS = {
             'T_before, T_after = op(V1), op(V_moved)\n'
             'rigid_err = 1e-13\n'
         ),
+        'copied from an earlier output (the printed bound < 1e-10 typed in as 0)': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before, T_after = op(V1), op(V_moved)\n'
+            'rigid_err = 0.0\n'
+        ),
+        'Q left out of the difference': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before, T_after = op(V1), op(V_moved)\n'
+            'rigid_err = float(np.abs(T_after - T_before).max())\n'
+        ),
+        'the gradients of Eq. (1) alone (op_pure) instead of the default op': (
+            'Q = so3_exp(np.array([0.3, -1.2, 2.0]))\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before, T_after = op_pure(V1), op_pure(V_moved)\n'
+            'rigid_err = float(np.abs(T_after - Q @ T_before).max())\n'
+        ),
+        'Q typed in as a matrix (so3_exp not used in the cell)': (
+            'Q = np.array([[-0.6761172459106027, -0.7150638736881626, -0.17762073732630712],\n'
+            '              [0.4932248264352887, -0.2601690323114642, -0.8300851433521718],\n'
+            '              [0.5473524827477636, -0.6488418383336542, 0.528592024587643]])\n'
+            'V_moved = V1 @ Q.T + np.array([1.0, 2.0, 3.0])\n'
+            'T_before, T_after = op(V1), op(V_moved)\n'
+            'rigid_err = float(np.abs(T_after - Q @ T_before).max())\n'
+        ),
     },
     2: {
-        'library weights typed in from the printout': (
-            'c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n'
-            'P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n'
-            'P_sq = np.array([[0.0, 0, 0], [1, 1, 0], [0, 1, 0], [1, 0, 0]])\n'
-            'pair = np.array([[0, 1, 2], [1, 0, 3]])\n'
-            'lib_eq, lib_sq = 1.1547, 0.0\n'
+        'copied from an earlier output (1.1547 and 0 as printed)': 'c_hand = np.array([1.1547, 0.0])\n',
+        'the exact values typed in (2 / sqrt(3) and 0)': 'c_hand = np.array([2 / np.sqrt(3), 0.0])\n',
+        "the library's weights stored as the hand values (the forbidden call; reader round 3)": (
+            'c_hand = np.array([cotangent_weights(X_, pair, clamp=False)[edge_index(edges(pair), 0, 1)] for X_ in pairs])\n'
         ),
-        'the square is never built': (
-            'c_equilateral, c_square_diagonal = 2 / np.tan(np.pi / 3), 2 / np.tan(np.pi / 2)\n'
-            'P_eq = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, -np.sqrt(3) / 2, 0]])\n'
-            'P_sq = P_eq.copy()\n'
-            'pair = np.array([[0, 1, 2], [1, 0, 3]])\n'
-            'lib_eq = float(cotangent_weights(P_eq, pair, clamp=False)[edge_index(edges(pair), 0, 1)])\n'
-            'lib_sq = 0.0\n'
+        'the library imported again inside the cell (the forbidden call)': (
+            'from meshvae_lib.geometry.cotangent import cotangent_weights as _cw\n'
+            'c_hand = np.array([_cw(X_, pair, clamp=False)[edge_index(edges(pair), 0, 1)] for X_ in pairs])\n'
+        ),
+        'the cotangent of one apex only': (
+            'c_hand = np.array([(X_[0] - X_[2]) @ (X_[1] - X_[2]) / np.linalg.norm(np.cross(X_[0] - X_[2], X_[1] - X_[2]))\n'
+            '                   for X_ in pairs])\n'
+        ),
+        'cosines instead of cotangents': (
+            'c_hand = np.array([sum((X_[0] - X_[k]) @ (X_[1] - X_[k]) / np.linalg.norm(X_[0] - X_[k]) / np.linalg.norm(X_[1] - X_[k])\n'
+            '                       for k in (2, 3)) for X_ in pairs])\n'
         ),
     },
     3: {
