@@ -23,6 +23,17 @@ WRONG_ANSWERS = {
             'rot_change = float(np.abs(f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
             's_change = float(np.abs(f_scaled[lay.scaling_slice] - s * f1[lay.scaling_slice]).max())\n'
         ),
+        'rotation and S changes typed in as zero (reader round 1)': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = 0.0\n'
+            's_change = 0.0\n'
+        ),
+        'the bound 1e-10 copied from an earlier output': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = s_change = 1e-10\n'
+        ),
     },
     2: {
         'V_lin is the feature midpoint': (
@@ -45,6 +56,19 @@ WRONG_ANSWERS = {
             'V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n'
             'stretch_mid, stretch_lin = (float(vertex_edge_stretch(X, V0, F).mean()) for X in (V_mid, V_lin))\n'
         ),
+        'the poses of PAIR hard-coded (reader round 1)': (
+            'Va, Vb = col.vertices[37], col.vertices[55]\n'
+            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
+            'V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n'
+            'L0 = np.linalg.norm(V0[E[:, 0]] - V0[E[:, 1]], axis=1)\n'
+            'stretch_mid, stretch_lin = (float(np.mean(np.abs(np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1) / L0 - 1))) for X in (V_mid, V_lin))\n'
+        ),
+        'the stretches copied from an earlier output': (
+            'Va, Vb = col.vertices[PAIR[0]], col.vertices[PAIR[1]]\n'
+            "V_mid = rec['exact'].reconstruct(0.5 * (enc.transform(Va) + enc.transform(Vb)))\n"
+            'V_lin = 0.5 * (Va + rigid_align(Vb, Va))\n'
+            'stretch_mid, stretch_lin = 0.029, 0.046\n'
+        ),
     },
     3: {
         'the angle copied from section 3 (1e-8)': (
@@ -53,13 +77,13 @@ WRONG_ANSWERS = {
             'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
             'err_library = abs(float(np.linalg.norm(so3_log(R32))) - theta_bad)\n'
         ),
-        'the angle copied from section 3 near pi (3.14159255)': (
+        'an angle next to pi (3.14159255)': (
             'theta_bad = 3.14159255\n'
             'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
             'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
             'err_library = abs(float(np.linalg.norm(so3_log(R32))) - theta_bad)\n'
         ),
-        'the errors of section 3 typed in': (
+        'the errors of section 3 copied from an earlier output': (
             'theta_bad = 1e-8\n'
             'err_textbook, err_library = 1.0e-08, 1e-15\n'
         ),
@@ -68,6 +92,15 @@ WRONG_ANSWERS = {
             'R64 = so3_exp(theta_bad * axis)\n'
             'err_textbook = abs(float(np.arccos(np.clip((np.trace(R64) - 1) / 2, -1, 1))) - theta_bad)\n'
             'err_library = abs(float(np.linalg.norm(so3_log(R64))) - theta_bad)\n'
+        ),
+        'the textbook error typed as theta_bad, the library error as 0 (reader round 1)': (
+            'theta_bad = 2e-4\n'
+            'err_textbook = theta_bad\n'
+            'err_library = 0.0\n'
+        ),
+        'the solution printout copied from an earlier output': (
+            'theta_bad = 2e-4\n'
+            'err_textbook, err_library = 2.0e-04, 1e-9\n'
         ),
     },
 }
