@@ -171,3 +171,15 @@ def test_model_summary_refuses_an_unfitted_model():
 
     with pytest.raises(NotFittedError):
         model_summary(MeshVAEModel())
+
+
+def test_local_parts_stretch_table_marks_the_ratios_over_the_limit_and_skips_unrecorded_collections():
+    from meshvae_lib.course.display import local_parts_stretch_table
+
+    stretch = {"held_out": 0.02, "mixed_ratio": 1.62, "mixed_ratio_5": 1.01, "prior_ratio": 1.5}
+    records = [{"collection": "pdance/3", "source": "real", "variants": {"4:spectral": {"stretch": stretch}}},
+               {"collection": "scape", "source": "synthetic", "variants": {"4:spectral": {}}}]
+    lines = local_parts_stretch_table(records, "4:spectral").splitlines()
+    assert len(lines) == 2 and lines[0].split()[:4] == ["collection", "held", "out", "any"]
+    assert lines[1].split() == ["pdance/3", "(real)", "0.020", "1.62*", "1.01", "1.50"]   # 1.5 is not over 1.5
+    assert local_parts_stretch_table(records, "4:spectral", limit=1.0).splitlines()[1].split()[3:] == ["1.62*", "1.01*", "1.50*"]

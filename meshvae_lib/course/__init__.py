@@ -11,7 +11,8 @@ from meshvae_lib.exports import exports_of, lazy_exports
 
 #: module (under this package) and the public names it defines, one line each.
 EXPORTS = exports_of(__name__, """
-display      describe_model first_argmax local_parts_figure local_parts_table model_summary roundoff
+display      describe_model first_argmax local_parts_figure local_parts_stretch_table local_parts_table model_summary
+display      roundoff
 display      real_feature_table real_inference_table span_ceiling_table spiral_figure spiral_table
 models       course_model get_spec
 answer_rerun record_cells rerun_answer

@@ -13,7 +13,8 @@ from meshvae_lib.defaults import DEFAULT_ARCHITECTURE
 from meshvae_lib.tolerances import TIE_RTOL
 
 __all__ = ["roundoff", "first_argmax", "real_inference_table", "real_feature_table", "span_ceiling_table",
-           "spiral_table", "spiral_figure", "local_parts_table", "local_parts_figure", "describe_model", "model_summary"]
+           "spiral_table", "spiral_figure", "local_parts_table", "local_parts_figure",
+           "local_parts_stretch_table", "describe_model", "model_summary"]
 
 #: the columns of :func:`spiral_table` and :func:`spiral_figure`: (record key, inference, label).
 _SPIRAL_COLUMNS = (("pca", None, "PCA coords"), ("spiral", "encoder", "spiral enc"),
@@ -213,6 +214,26 @@ def local_parts_figure(records, variant: str):
     ax.legend(ncol=4, fontsize=8, frameon=False)
     fig.tight_layout()
     return fig
+
+
+def local_parts_stretch_table(records, variant: str, limit: float = 1.5) -> str:
+    """The recorded edge stretch of meshes that mix parts (``variants[variant]["stretch"]`` of
+    ``docs/results/local_parts.json``, see :func:`local_parts_table`: ``held_out``, the mean relative
+    edge-length change of held-out meshes against their nearest training mesh, and each kind of
+    generated mesh's ratio to it: ``mixed_ratio``, every region's source among all training meshes;
+    ``mixed_ratio_5``, among a base mesh's 5 nearest; ``prior_ratio``, prior samples). One line per
+    collection that records them, ratios with 2 decimals; ``*`` marks a ratio over ``limit``.
+    Recorded numbers, the same on every machine."""
+    head = f"{'collection':22s} {'held out':>9s} {'any sources':>12s} {'5 nearest':>10s} {'prior':>7s}"
+    lines = [head + f"   (ratios to the held-out stretch; * over {limit}x)"]
+    for r in records:
+        s = r["variants"][variant].get("stretch")
+        if s is None:
+            continue
+        name = f"{r['collection']} ({'real' if r['source'] == 'real' else 'stand-in'})"
+        marks = [f"{s[k]:.2f}{'*' if s[k] > limit else ' '}" for k in ("mixed_ratio", "mixed_ratio_5", "prior_ratio")]
+        lines.append(f"{name:22s} {s['held_out']:9.3f} {marks[0]:>12s} {marks[1]:>10s} {marks[2]:>7s}".rstrip())
+    return "\n".join(lines)
 
 
 def describe_model(model) -> dict:

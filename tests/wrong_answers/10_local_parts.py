@@ -19,6 +19,11 @@ WRONG_ANSWERS = {
             '                                       seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
             "err_two = errors['local parts']\n"
         ),
+        'the error copied from an earlier output (the 2 regions line printed by the solution, 2.8e-04)': (
+            'two = MeshVAEModel("rimd", TrainConfig(architecture="local-parts", latent_dim=LATENT, network_options={"n_regions": 2},\n'
+            '                                       seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
+            'err_two = 2.8e-04\n'
+        ),
         'measured on every mesh, training ones included': (
             'two = MeshVAEModel("rimd", TrainConfig(architecture="local-parts", latent_dim=LATENT, network_options={"n_regions": 2},\n'
             '                                       seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
