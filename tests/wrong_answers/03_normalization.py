@@ -75,6 +75,10 @@ WRONG_ANSWERS = {
             'f_top = norm.max_ + (1 - norm.a) / (2 * norm.a) * (norm.max_ - norm.min_)\n'
             'margin = (f_top - X.max(axis=0)) / (X.max(axis=0) - X.min(axis=0))\n'
         ),
+        'f_top at an output of -1 (the lower end of the range)': (
+            'f_top = norm.inverse_transform(-np.ones((1, X.shape[1])))[0]\n'
+            'margin = (X.min(axis=0) - f_top) / (X.max(axis=0) - X.min(axis=0))\n'
+        ),
         'f_top is the training maximum': (
             'f_top = X.max(axis=0)\n'
             'margin = np.full(X.shape[1], 1 / 18)\n'
