@@ -34,6 +34,11 @@ WRONG_ANSWERS = {
             'f_scaled = enc.transform(s * V1)\n'
             'rot_change = s_change = 1e-10\n'
         ),
+        'the bound 1e-9 of the solution printout copied (reader round 2)': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = s_change = 1e-9\n'
+        ),
     },
     2: {
         'V_lin is the feature midpoint': (
@@ -101,6 +106,12 @@ WRONG_ANSWERS = {
         'the solution printout copied from an earlier output': (
             'theta_bad = 2e-4\n'
             'err_textbook, err_library = 2.0e-04, 1e-9\n'
+        ),
+        'the library error typed as 1/1000 of the printed textbook error (reader round 2)': (
+            'theta_bad = 2e-4\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = 2.0e-04 / 1000\n'
         ),
     },
 }
