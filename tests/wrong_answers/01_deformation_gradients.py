@@ -61,6 +61,19 @@ WRONG_ANSWERS = {
             'from meshvae_lib.geometry.cotangent import cotangent_weights as _cw\n'
             'c_hand = np.array([_cw(X_, pair, clamp=False)[edge_index(edges(pair), 0, 1)] for X_ in pairs])\n'
         ),
+        "the library's corner cotangents summed over the two apexes (reader round 4)": (
+            'from meshvae_lib.geometry.cotangent import corner_cotangents\n'
+            'c_hand = np.array([corner_cotangents(X_, pair)[0, 2] + corner_cotangents(X_, pair)[1, 2] for X_ in pairs])\n'
+        ),
+        "the raw weights of a DeformationGradientOperator built on each pair (reader round 4)": (
+            'c_hand = np.array([DeformationGradientOperator(X_, pair, clamp=False).weights[edge_index(edges(pair), 0, 1)]\n'
+            '                   for X_ in pairs])\n'
+        ),
+        "the library's weights through the package's top-level export": (
+            'import meshvae_lib\n'
+            'c_hand = np.array([meshvae_lib.cotangent_weights(X_, pair, clamp=False)[edge_index(edges(pair), 0, 1)]\n'
+            '                   for X_ in pairs])\n'
+        ),
         'the cotangent of one apex only': (
             'c_hand = np.array([(X_[0] - X_[2]) @ (X_[1] - X_[2]) / np.linalg.norm(np.cross(X_[0] - X_[2], X_[1] - X_[2]))\n'
             '                   for X_ in pairs])\n'
@@ -90,7 +103,7 @@ WRONG_ANSWERS = {
             'T3 = np.array([[0, 1, 2], [0, 1, 3]])\n'
             'c_neg = float(cotangent_weights(P3, T3, clamp=False)[edge_index(edges(T3), 0, 1)])\n'
         ),
-        'a weight below -5 typed in for a pair that does not have it': (
+        'copied from an earlier output (-19.95 as printed), for a pair that does not have it': (
             'P3, T3 = P.copy(), T2.copy()\n'
             'c_neg = -19.95\n'
         ),
