@@ -16,6 +16,7 @@ display      real_feature_table real_inference_table span_ceiling_table spiral_f
 models       course_model get_spec
 answer_rerun record_cells rerun_answer
 prior_costs  one_dimension_cost prior_cost_figure
+table_row    FLOOR_COLUMN column_reconstructions
 """)
 
 __all__ = sorted(EXPORTS)
