@@ -18,6 +18,7 @@ models       course_model get_spec
 answer_rerun record_cells rerun_answer
 gradient_fits gradient_fit_stats
 prior_costs  one_dimension_cost prior_cost_figure
+table_row    FLOOR_COLUMN column_reconstructions
 """)
 
 __all__ = sorted(EXPORTS)

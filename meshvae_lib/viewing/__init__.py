@@ -21,6 +21,7 @@ module                      public names
 ``explorer``                ``LatentExplorer``
 ``latent_pad``              ``LatentPad``
 ``convergence_curves``      ``convergence_figure``, ``epochs_past_best``
+``floor_figures``           ``per_mesh_error_figure``, ``floor_ratio_figure``
 ``embedding_maps``          ``embedding_maps_figure``
 ``interpolation_measures``  ``interpolation_measures_figure``
 ``marked_vertices``         ``marked_vertices_figure``
@@ -53,6 +54,7 @@ widgets                 FramePlayer InterpolationSlider
 explorer                LatentExplorer
 latent_pad              LatentPad
 convergence_curves      convergence_figure epochs_past_best
+floor_figures           per_mesh_error_figure floor_ratio_figure
 embedding_maps          embedding_maps_figure
 interpolation_measures  interpolation_measures_figure
 marked_vertices         marked_vertices_figure

@@ -1,5 +1,5 @@
 """Validation curves of models trained until they stop improving, drawn so that their ends can be read
-(notebook 09).
+(the recorded converged tables of ``docs/results``).
 
 :func:`convergence_figure` draws a recorded experiment's validation curves (``results.json``:
 ``tables[name]["validation_curves"]``, row -> model -> ``epochs``, ``val_mse``, ``chosen``) as one

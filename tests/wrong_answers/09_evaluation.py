@@ -3,53 +3,74 @@
 Keys are exercise numbers from 1; values map a short description to the code run in place of
 the solution (tests/test_exercise_checks.py runs them)."""
 
+_PCA_BY_HAND = (
+    'X = V_train.reshape(len(V_train), -1)\n'
+    'mean = X.mean(axis=0)\n'
+)
+
 WRONG_ANSWERS = {
     1: {
-        'the floor copied from the table': (
-            "pca_err = rows['jumping']['ours aligned']\n"
-            "rimd_over_pca = rows['jumping']['ours rimd'] / pca_err\n"
+        'copied from an earlier output (the mean floor printed in section 2, 1.1e-02, typed in for every mesh)': (
+            'floor_mine = np.full(len(V_test), 1.1e-02)\n'
         ),
-        'a floor of zero': (
-            'pca_err = 0.0\n'
-            "rimd_over_pca = float('inf')\n"
+        "copied from an earlier output, exact (section 2's per-mesh floor pasted as numbers)": (
+            "floor_mine = np.array([float(e) for e in floor['per_mesh']])\n"
         ),
-        'the printed floor, rounded (3.1e-05)': (
-            'pca_err = 3.1e-05\n'
-            "rimd_over_pca = rows['face']['ours rimd'] / pca_err\n"
+        'every direction the training meshes span, not D': _PCA_BY_HAND + (
+            'directions = np.linalg.svd(X - mean, full_matrices=False)[2]\n'
+            'Y = V_test.reshape(len(V_test), -1) - mean\n'
+            'floor_mine = per_vertex_error((mean + Y @ directions.T @ directions).reshape(V_test.shape), V_test)\n'
+        ),
+        'the coordinates not centred on their mean': _PCA_BY_HAND + (
+            'directions = np.linalg.svd(X, full_matrices=False)[2][:D]\n'
+            'Y = V_test.reshape(len(V_test), -1)\n'
+            'floor_mine = per_vertex_error((Y @ directions.T @ directions).reshape(V_test.shape), V_test)\n'
+        ),
+        'no rigid alignment before measuring': _PCA_BY_HAND + (
+            'directions = np.linalg.svd(X - mean, full_matrices=False)[2][:D]\n'
+            'Y = V_test.reshape(len(V_test), -1) - mean\n'
+            'projected = (mean + Y @ directions.T @ directions).reshape(V_test.shape)\n'
+            'floor_mine = np.linalg.norm(projected - V_test, axis=-1).mean(axis=1)\n'
+        ),
+        'the forbidden library call (pca_baseline)': (
+            "floor_mine = np.array(pca_baseline(V_train, V_test, n_components=D)['per_mesh'])\n"
+        ),
+        'the forbidden library call, imported again under another name (CoordinatePCA)': (
+            'from meshvae_lib.model.evaluation import CoordinatePCA as Linear\n'
+            'floor_mine = per_vertex_error(Linear(D).fit(V_train).reconstruct(V_test), V_test)\n'
         ),
     },
     2: {
-        'the quick table reused': (
-            't2_longer = t2_quick\n'
-            "gain = {'coords': 1.0, 'aligned': 1.0, 'rimd': 1.0}\n"
+        'copied from an earlier output (the means printed in section 2 typed in for every mesh)': (
+            'err_encoder = np.full(len(meshes), 1.2e-02)\n'
+            'err_gn = np.full(len(meshes), 1.6e-03)\n'
         ),
-        "the default arguments (the quick preset's steps)": (
-            'longer = paper.ExperimentSettings.quick(seed=SEED)\n'
-            't2_longer = paper.feature_table([COLLECTIONS[0]], settings=longer, cache={})\n'
-            "gain = {k: t2_longer.as_dicts()[0][f'ours {k}'] / t2_quick.as_dicts()[0][f'ours {k}'] for k in ('coords', 'aligned', 'rimd')}\n"
+        "copied from an earlier output, exact (section 2's per-mesh errors pasted as numbers)": (
+            "err_encoder = np.array([float(e) for e in row['RIMD, encoder']['per_mesh']])\n"
+            "err_gn = np.array([float(e) for e in row['RIMD, gauss-newton']['per_mesh']])\n"
         ),
-        'the ratio inverted (quick / longer)': (
-            'longer = paper.ExperimentSettings.quick(seed=SEED, train_steps=3 * settings.train_steps)\n'
-            't2_longer = paper.feature_table([COLLECTIONS[0]], settings=longer, cache={})\n'
-            "gain = {k: t2_quick.as_dicts()[0][f'ours {k}'] / t2_longer.as_dicts()[0][f'ours {k}'] for k in ('coords', 'aligned', 'rimd')}\n"
+        'no rigid alignment before measuring': (
+            "err_encoder = np.linalg.norm(model.reconstruct(meshes, inference='encoder') - meshes, axis=-1).mean(axis=1)\n"
+            "err_gn = np.linalg.norm(model.reconstruct(meshes, inference='gauss-newton') - meshes, axis=-1).mean(axis=1)\n"
         ),
-    },
-    3: {
-        'the threshold applied to the learned errors': (
-            "floor_rel = {name: rows[name]['ours rimd'] for name in rows}\n"
-            'informative = [name for name in rows if floor_rel[name] >= 1e-4]\n'
+        'the encoder for both': (
+            "rec_encoder = rigid_align(model.reconstruct(meshes, inference='encoder'), meshes)\n"
+            'err_encoder = np.linalg.norm(rec_encoder - meshes, axis=-1).mean(axis=1)\n'
+            'err_gn = err_encoder.copy()\n'
         ),
-        'absolute floors, not relative to the diagonal': (
-            'floor_rel = {}\n'
-            'for name in rows:\n'
-            '    coll = paper.load_collection(name, full.settings)\n'
-            '    held = holdout_mask(len(coll.vertices), full.settings.holdout_every)\n'
-            "    floor_rel[name] = float(pca_baseline(coll.vertices[~held], coll.vertices[held])['mean_vertex_error'])\n"
-            'informative = [name for name in rows if floor_rel[name] >= 1e-4]\n'
+        'the root mean square distance, not the mean': (
+            "rec_encoder = rigid_align(model.reconstruct(meshes, inference='encoder'), meshes)\n"
+            "rec_gn = rigid_align(model.reconstruct(meshes, inference='gauss-newton'), meshes)\n"
+            'err_encoder = np.sqrt(((rec_encoder - meshes) ** 2).sum(axis=-1).mean(axis=1))\n'
+            'err_gn = np.sqrt(((rec_gn - meshes) ** 2).sum(axis=-1).mean(axis=1))\n'
         ),
-        "the table's column copied": (
-            "floor_rel = {name: rows[name]['floor / diagonal'] for name in rows}\n"
-            "informative = [name for name in rows if rows[name]['informative'] == 'yes']\n"
+        'the forbidden library call (evaluate_model)': (
+            "err_encoder = np.array(evaluate_model(model, coll, indices=held, inference='encoder')['per_mesh'])\n"
+            "err_gn = np.array(evaluate_model(model, coll, indices=held, inference='gauss-newton')['per_mesh'])\n"
+        ),
+        'the forbidden library call (per_vertex_error)': (
+            "err_encoder = per_vertex_error(model.reconstruct(meshes, inference='encoder'), meshes)\n"
+            "err_gn = per_vertex_error(model.reconstruct(meshes, inference='gauss-newton'), meshes)\n"
         ),
     },
 }
