@@ -16,6 +16,7 @@ display      real_feature_table real_inference_table span_ceiling_table spiral_f
 models       course_model get_spec
 answer_rerun record_cells rerun_answer
 prior_costs  one_dimension_cost prior_cost_figure
+tour         linear_floor_detail unseen_surfaces shuffled_gallery
 """)
 
 __all__ = sorted(EXPORTS)
