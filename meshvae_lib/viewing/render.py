@@ -319,7 +319,6 @@ def render_mesh_grid(
     nr = int(math.ceil(k / nc))
     extra = 0.7 if (colorbar is not None or legend) else 0.0
     lines = max((str(t).count("\n") + 1 for t in titles), default=1) if titles is not None else 0
-    # room for the titles' lines (under a suptitle, from the second line on: the suptitle needs its own)
     top = (0.35 if suptitle else 0.0) + (0.25 + 0.16 * max(lines - (1 if suptitle else 2), 0) if titles is not None else 0.0)
     fig = MeshFigure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
     R = view_basis(view, up)
