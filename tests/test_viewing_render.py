@@ -199,3 +199,24 @@ def test_grid_figure_shows_as_png_without_pyplot(sphere):
     png = fig._repr_png_()
     assert png[:4] == b"\x89PNG"
     assert _png_pixels(png).shape[:2] == (40, 40)
+
+
+def test_multi_line_titles_clear_the_suptitle_and_the_row_above():
+    import trimesh
+
+    from meshvae_lib.viewing.render import render_mesh_grid
+
+    s = trimesh.creation.icosphere(subdivisions=1)
+    V, F = np.asarray(s.vertices), np.asarray(s.faces)
+    fig = render_mesh_grid([V] * 4, F, titles=["a\nb\nc"] * 4, ncols=2, size=2.6, suptitle="a suptitle")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    sup = fig._suptitle.get_window_extent(renderer)
+    axes = fig.axes[:4]
+    first_row_titles = [ax.title.get_window_extent(renderer) for ax in axes[:2]]
+    assert all(t.y1 <= sup.y0 for t in first_row_titles), "the first row's titles stay under the suptitle"
+    second_row_titles = [ax.title.get_window_extent(renderer) for ax in axes[2:]]
+    assert all(t.y1 <= ax.get_window_extent(renderer).y0 + 1 for t, ax in zip(second_row_titles, axes[:2])), \
+        "the second row's titles stay under the first row's panels"

@@ -152,3 +152,18 @@ def test_colour_list_with_default_entries(sphere):
 
     np.testing.assert_allclose(v._color_attrs[0].array[0], to_rgb(DEFAULT_MESH_COLOR), atol=1e-6)
     np.testing.assert_allclose(v._color_attrs[1].array, red, atol=1e-6)
+
+
+def test_the_snapshot_takes_the_panel_size_asked_for(sphere):
+    V, F = sphere
+
+    def png_size(png):
+        return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")   # IHDR width, height
+
+    big = MeshViewer([V, V, V], F, mode="threejs", snapshot_size=2.6, snapshot_dpi=90)._repr_mimebundle_()["image/png"]
+    w, h = png_size(big)
+    assert w >= 3 * 2.6 * 90 - 20 and h >= 2.6 * 90, f"3 panels of 2.6 inches at 90 dpi, got {w}x{h} px"
+    small = png_size(MeshViewer([V, V, V], F, mode="threejs").snapshot_png())
+    assert small[0] < w and small[1] < h, "the default snapshot is the smaller one"
+    with pytest.raises(ValueError, match="snapshot_size"):
+        MeshViewer(V, F, mode="threejs", snapshot_size=0)

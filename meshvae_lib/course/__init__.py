@@ -19,6 +19,7 @@ answer_rerun record_cells rerun_answer
 gradient_fits gradient_fit_stats
 prior_costs  one_dimension_cost prior_cost_figure
 table_row    FLOOR_COLUMN column_reconstructions
+tour         linear_floor_detail unseen_surfaces shuffled_gallery
 """)
 
 __all__ = sorted(EXPORTS)

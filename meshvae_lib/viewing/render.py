@@ -319,7 +319,7 @@ def render_mesh_grid(
     nr = int(math.ceil(k / nc))
     extra = 0.7 if (colorbar is not None or legend) else 0.0
     lines = max((str(t).count("\n") + 1 for t in titles), default=1) if titles is not None else 0
-    top = (0.35 if suptitle else 0.0) + (0.25 + 0.16 * max(lines - 2, 0) if titles is not None else 0.0)
+    top = (0.35 if suptitle else 0.0) + (0.25 + 0.16 * max(lines - (1 if suptitle else 2), 0) if titles is not None else 0.0)
     fig = MeshFigure(figsize=(size * nc, size * nr + extra + top), dpi=dpi)
     R = view_basis(view, up)
     extent = None
@@ -333,7 +333,7 @@ def render_mesh_grid(
     height = size * nr + extra + top
     bottom = extra / height
     fig.subplots_adjust(left=0.01, right=0.99, top=1.0 - top / height - 0.01, bottom=bottom + 0.01, wspace=0.02,
-                        hspace=0.15 if titles is not None else 0.02)
+                        hspace=(max(0.15, (0.1 + 0.17 * lines) / size) if lines >= 2 else 0.15) if titles is not None else 0.02)
     if colorbar is not None:
         _add_colorbar(fig, colorbar, bottom)
     if legend:

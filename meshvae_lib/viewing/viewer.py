@@ -97,6 +97,8 @@ class MeshViewer:
         In "threejs" mode, also put a small matplotlib PNG of the initial state into the display
         data. JupyterLab shows the live 3D view; exports without widget state (nbconvert HTML,
         GitHub) and untrusted notebooks show the PNG instead of an empty widget.
+    snapshot_size : float
+        Inches per panel of that PNG (default 2.2, at ``snapshot_dpi`` dots per inch, default 60).
 
     Attributes
     ----------
@@ -116,7 +118,8 @@ class MeshViewer:
     def __init__(self, V, F, colors=None, values=None, cmap: str = "viridis", vmin=None, vmax=None,
                  value_label: str = "", labels=None, titles=None, width: int = 720, height: int = 400,
                  gap: float = 0.25, background: str = "#ffffff", flat_shading: bool = False,
-                 wireframe: bool = False, mode: str = "auto", snapshot: bool = True):
+                 wireframe: bool = False, mode: str = "auto", snapshot: bool = True,
+                 snapshot_size: float = 2.2, snapshot_dpi: int = 60):
         Vs = as_mesh_stack(V)
         self.n_meshes, self.n_vertices = Vs.shape[0], Vs.shape[1]
         self.F = np.asarray(F).astype(np.int64)
@@ -129,6 +132,9 @@ class MeshViewer:
         self.width, self.height = int(width), int(height)
         self.mode = resolve_mode(mode)
         self.snapshot = bool(snapshot)
+        if not snapshot_size > 0 or not snapshot_dpi > 0:
+            raise ValueError(f"snapshot_size and snapshot_dpi must be positive, got {snapshot_size}, {snapshot_dpi}")
+        self.snapshot_size, self.snapshot_dpi = float(snapshot_size), int(snapshot_dpi)
         self.n_updates = 0
         self.last_update_ms = float("nan")
         self.mapping: ColorMapping | None = None
@@ -322,11 +328,13 @@ class MeshViewer:
         return render_mesh_grid([p.astype(np.float64) for p in self.positions], self.F, titles=self.titles,
                                 colors=self._colors, colorbar=self.mapping, legend=self.legend, **render_kw)
 
-    def snapshot_png(self, size: float = 2.2, dpi: int = 60) -> bytes:
-        """A small PNG of the current state: ``bytes``."""
+    def snapshot_png(self, size: float | None = None, dpi: int | None = None) -> bytes:
+        """A small PNG of the current state: ``bytes``; ``size`` inches per panel at ``dpi`` dots per
+        inch (default the viewer's ``snapshot_size`` and ``snapshot_dpi``)."""
         from .render import figure_to_png
 
-        return figure_to_png(self.figure(size=size, dpi=dpi))
+        return figure_to_png(self.figure(size=self.snapshot_size if size is None else size,
+                                         dpi=self.snapshot_dpi if dpi is None else dpi))
 
     # -- display -------------------------------------------------------------------------------
     def __repr__(self) -> str:

@@ -73,6 +73,9 @@ class FramePlayer(_Displayable):
         A scalar per vertex and frame (e.g. each method's error over time), coloured on one range
         for the whole sequence (``vmin``/``vmax`` default to its minimum and maximum), with a
         colour bar; ``cmap`` and ``value_label`` as for :class:`MeshViewer`.
+    static_size : float
+        Inches per panel of :meth:`static_png`, the strip a page without widgets shows (default
+        ``defaults.STATIC_PANEL_INCHES``).
     **viewer_kw
         Passed to :class:`MeshViewer` (``colors``, ``values``, ``width``, ``mode``, ...).
 
@@ -86,9 +89,12 @@ class FramePlayer(_Displayable):
     """
 
     def __init__(self, frames, F, fps: float = 10.0, titles=None, loop: bool = True, frame_values=None,
-                 **viewer_kw):
+                 static_size: float = STATIC_PANEL_INCHES, **viewer_kw):
         import ipywidgets as W
 
+        if not static_size > 0:
+            raise ValueError(f"static_size must be positive, got {static_size}")
+        self.static_size = float(static_size)
         seqs = frames if isinstance(frames, (list, tuple)) else [frames]
         stacks = []
         for i, s in enumerate(seqs):
@@ -165,7 +171,7 @@ class FramePlayer(_Displayable):
         meshes = [self._frames[i, s] for s in range(n_seq) for i in idx]
         titles = [f"{names[s]} frame {i}".strip() for s in range(n_seq) for i in idx]
         return figure_to_png(render_mesh_grid(meshes, self.viewer.F, titles=titles, ncols=len(idx),
-                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
+                                              size=self.static_size, dpi=STATIC_DPI))
 
     def _static_frames(self) -> np.ndarray:
         """The strip's frame indices: ``STATIC_STRIP_FRAMES`` evenly spaced, first and last included."""
