@@ -40,6 +40,7 @@ __all__ = [
     "dimension_effects",
     "DimensionEffects",
     "dimension_displacement",
+    "data_spread",
 ]
 
 #: names returned by ``measure_humanoid``, in order.
@@ -363,8 +364,12 @@ def dimension_displacement(model, dims: Sequence[int] | None = None, base=None,
     Z[np.arange(len(dims)), 1, dims] = hi
     V = np.asarray(model.decode_latent(Z.reshape(-1, D)), dtype=np.float64).reshape(len(dims), 2, -1, 3)
     dist = per_vertex_error(V[:, 0], V[:, 1])
-    if reference_vertices is not None:
-        R = np.asarray(reference_vertices, dtype=np.float64)
-        spread = float(per_vertex_error(R, np.broadcast_to(R.mean(axis=0), R.shape), align=False).mean())
-        dist = dist / (spread if spread > 0 else 1.0)
-    return dist
+    return dist if reference_vertices is None else dist / data_spread(reference_vertices)
+
+
+def data_spread(reference_vertices) -> float:
+    """The unit of :func:`dimension_displacement`: the mean vertex distance of the meshes ``(M, n, 3)``
+    to their mean mesh (no alignment), averaged over them; 1.0 where that is 0. Returns a float."""
+    R = np.asarray(reference_vertices, dtype=np.float64)
+    spread = float(per_vertex_error(R, np.broadcast_to(R.mean(axis=0), R.shape), align=False).mean())
+    return spread if spread > 0 else 1.0
