@@ -156,6 +156,11 @@ def test_model_summary_says_the_start_the_epochs_and_what_training_changed():
         assert d["mse_first"] == d["mse_last"] and "(chosen by early stopping): the model is its start" in model_summary(chosen)
     else:
         assert f"{d['epochs']} of 1000 epochs (chosen by early stopping)" in model_summary(chosen)
+    portable = model_summary(chosen, portable=True)
+    assert "early stopping ended it within the budget of 1000 epochs" in portable and f"{d['epochs']} of 1000" not in portable
+    assert f"{d['mse_last']:.2g} after the last" in portable and len(portable.splitlines()) == 4
+    # a fixed budget is no choice: portable keeps its count
+    assert "5 of 5 epochs (a fixed budget)" in model_summary(start, portable=True)
     # the default latent size holds every training row: the start is kept without a search
     kept = MeshVAEModel("rimd", TrainConfig(progress=False), holdout_every=4).fit(_strips(40))
     d = describe_model(kept)

@@ -127,6 +127,20 @@ def test_render_mesh_grid_layout_titles_colorbar_and_png(sphere):
     assert spans[1] > 1.1 * spans[0]
 
 
+def test_render_mesh_grid_suptitle_stays_above_two_line_titles(sphere):
+    V, F = sphere
+    fig = render_mesh_grid(np.stack([V] * 6), F, titles=["nearest: male_tall_slim\njumping_jacks"] * 6, ncols=3,
+                           size=2.5, suptitle="rows: one | two")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    sup = fig._suptitle.get_window_extent(renderer)
+    titles = [ax.title.get_window_extent(renderer) for ax in fig.axes]
+    assert sup.y1 <= fig.bbox.y1 and sup.y0 > max(t.y1 for t in titles), "the suptitle clears every panel title"
+
+
 def test_render_mesh_grid_validates(sphere):
     V, F = sphere
     with pytest.raises(ValueError, match="vertex counts"):

@@ -276,10 +276,15 @@ def describe_model(model) -> dict:
     }
 
 
-def model_summary(model) -> str:
+def model_summary(model, portable: bool = False) -> str:
     """A few lines that say which model a lesson uses: its network, its start, how long it trained
     and what training changed (see :func:`describe_model`). Training digits differ between
-    machines: print it in a ``# NBVAL_IGNORE_OUTPUT`` cell."""
+    machines: print it in a ``# NBVAL_IGNORE_OUTPUT`` cell.
+
+    portable : leave out what is a choice among near-ties on another CPU -- the epoch count that
+        early stopping chose (the epoch of lowest validation error on a flat curve) -- and print the
+        training MSEs with two significant digits. Returns a str of four lines either way.
+    """
     d = describe_model(model)
     layers = "no internal layer (one linear map each way)" if not d["hidden"] else \
         "internal layers " + " -> ".join(str(h) for h in d["hidden"])
@@ -289,12 +294,15 @@ def model_summary(model) -> str:
     start = "the PCA of the training features" if d["start"] == "PCA" else "random weights (PyTorch's initialisation)"
     chosen = ("no epoch search: the start's span holds every training row" if d["search_skipped"] else
               "chosen by early stopping" if d["early_stopping"] else "a fixed budget")
+    digits = ".2g" if portable else ".3g"
+    epochs = (f"early stopping ended it within the budget of {d['epoch_budget']} epochs" if portable and d["early_stopping"]
+              else f"{d['epochs']} of {d['epoch_budget']} epochs ({chosen})")
     if d["epochs"] == 0:
-        trained = f"0 of {d['epoch_budget']} epochs ({chosen}): the model is its start"
+        trained = f"{epochs}: the model is its start"
     else:
         change = d["mse_last"] / d["mse_first"] - 1 if d["mse_first"] > 0 else 0.0
-        trained = (f"{d['epochs']} of {d['epoch_budget']} epochs ({chosen}); training MSE {d['mse_first']:.3g} "
-                   f"after the first epoch, {d['mse_last']:.3g} after the last ({change:+.0%})")
+        trained = (f"{epochs}; training MSE {d['mse_first']:{digits}} "
+                   f"after the first epoch, {d['mse_last']:{digits}} after the last ({change:+.0%})")
     return "\n".join([
         f"features: {d['features']} (K = {d['n_features']}), latent {d['latent_dim']} ({d['used_dims']} used)",
         f"network:  {layers}" + "".join(", " + e for e in extras),

@@ -338,8 +338,8 @@ def render_mesh_grid(
         _add_colorbar(fig, colorbar, bottom)
     if legend:
         _add_legend(fig, legend)
-    if suptitle:
-        fig.suptitle(suptitle)
+    if suptitle:  # hung from the figure's top edge, so that it stays above two-line panel titles
+        fig.suptitle(suptitle, y=1.0 - 0.04 / height, va="top")
     return fig
 
 

@@ -21,6 +21,19 @@ _BISECTION_WRITTEN_IN = (
     '    lo, hi = (w_mid, hi) if per_vertex_error(V_w, V_a).mean() < per_vertex_error(V_w, V_b).mean() else (lo, w_mid)\n'
 )
 
+#: the solution of exercise 3 with one of the pair or the motion written in (format with the three expressions)
+_BISECTION = (
+    'from meshvae_lib.model import per_vertex_error\n'
+    'z0 = np.zeros((1, cond.latent_dim))\n'
+    'c_a, c_b = (cond.condition_vector({{"shape": s, "motion": {motion}}}) for s in ({a}, {b}))\n'
+    'V_a, V_b = cond.decode_latent(z0, conditions=c_a), cond.decode_latent(z0, conditions=c_b)\n'
+    'lo, hi = 0.0, 1.0\n'
+    'for _ in range(30):\n'
+    '    w_mid = (lo + hi) / 2\n'
+    '    V_w = cond.decode_latent(z0, conditions=(1 - w_mid) * c_a + w_mid * c_b)\n'
+    '    lo, hi = (w_mid, hi) if per_vertex_error(V_w, V_a).mean() < per_vertex_error(V_w, V_b).mean() else (lo, w_mid)\n'
+)
+
 WRONG_ANSWERS = {
     1: {
         'the overall mean copied for every motion': 'per_motion = np.full(len(motions), 0.99)\n',
@@ -34,6 +47,14 @@ WRONG_ANSWERS = {
             'per_motion = np.array([1.0, 1.0, 1.0, 1.0, 1.0, 0.9, 1.0])\n'),
         "the lesson's seed and number of draws written in instead of SEED and N_PER_LABEL": (
             'per_motion = generation.condition_agreement(cond, coll, "motion", n=10, seed=0, dataset_features=X)\n'),
+        "the lesson's number of draws written in instead of N_PER_LABEL": (
+            'per_motion = generation.condition_agreement(cond, coll, "motion", n=10, seed=SEED, dataset_features=X)\n'),
+        "seed 0 written in instead of SEED": (
+            'per_motion = generation.condition_agreement(cond, coll, "motion", n=N_PER_LABEL, seed=0, dataset_features=X)\n'),
+        'every motion obeyed, ones typed': 'per_motion = np.ones(len(motions))\n',
+        "the collection built again instead of coll": (
+            'per_motion = generation.condition_agreement(cond, get_spec(COND).make_collection(), "motion", n=N_PER_LABEL,'
+            ' seed=SEED, dataset_features=X)\n'),
     },
     2: {
         'each mesh is its own nearest neighbour': (
@@ -59,5 +80,8 @@ WRONG_ANSWERS = {
         'the other body': 'w_mid = 1.0\n',
         'copied from an earlier output (w = 0.466 the solution shows)': 'w_mid = 0.466\n',
         "the lesson's pair and motion written in instead of SHAPE_A, SHAPE_B, BLEND_MOTION": _BISECTION_WRITTEN_IN,
+        '"walk" written in instead of BLEND_MOTION': _BISECTION.format(a="SHAPE_A", b="SHAPE_B", motion='"walk"'),
+        "the lesson's pair written in instead of SHAPE_A, SHAPE_B": _BISECTION.format(
+            a='"female_heavy"', b='"male_tall_slim"', motion="BLEND_MOTION"),
     },
 }
