@@ -78,6 +78,10 @@ WRONG_ANSWERS = {
             'c_hand = np.array([(X_[0] - X_[2]) @ (X_[1] - X_[2]) / np.linalg.norm(np.cross(X_[0] - X_[2], X_[1] - X_[2]))\n'
             '                   for X_ in pairs])\n'
         ),
+        "the one-ring figure's apex angles, their cotangents taken by hand (reader round 5)": (
+            'from meshvae_lib.viewing.one_ring_figure import _angle\n'
+            'c_hand = np.array([1 / np.tan(_angle(X_[2], X_[0], X_[1])) + 1 / np.tan(_angle(X_[3], X_[0], X_[1])) for X_ in pairs])\n'
+        ),
         'cosines instead of cotangents': (
             'c_hand = np.array([sum((X_[0] - X_[k]) @ (X_[1] - X_[k]) / np.linalg.norm(X_[0] - X_[k]) / np.linalg.norm(X_[1] - X_[k])\n'
             '                       for k in (2, 3)) for X_ in pairs])\n'
