@@ -100,9 +100,25 @@ WRONG_ANSWERS = {
         "the PCA start's a = 0.3": 'a_max = 0.3\nmargin_max = (1 - a_max) / (2 * a_max)\n',
         'the lower end of the search': 'a_max = 0.5\nmargin_max = (1 - a_max) / (2 * a_max)\n',
         "exercise 2's margin copied": 'a_max = 0.7\nmargin_max = 1 / 18\n',
-        'copied from an earlier output (a_max = 0.700 and its 21.4% as printed)': 'a_max = 0.7\nmargin_max = 0.214\n',
+        'the old 0.01-grid printout copied (a_max = 0.700 and its 21.4%)': 'a_max = 0.7\nmargin_max = 0.214\n',
         'a_max typed in, with its margin computed': 'a_max = 0.7\nmargin_max = (1 - a_max) / (2 * a_max)\n',
         'the formula with the threshold typed in': 'a_max = float(np.sqrt(1 - 0.5))\nmargin_max = (1 - a_max) / (2 * a_max)\n',
         'the gradient taken as 1 - a instead of 1 - a^2': 'a_max = 1 - g_min\nmargin_max = (1 - a_max) / (2 * a_max)\n',
+        'copied from an earlier output (a_max = 0.707107 and its 20.7% as printed)': 'a_max = 0.707107\nmargin_max = 0.207\n',
+        'copied from an earlier output, a_max rounded down (0.707106) with its margin computed': (
+            'a_max = 0.707106\nmargin_max = (1 - a_max) / (2 * a_max)\n'
+        ),
+        'a search in steps of 0.01 (0.700: not the largest a to 1e-6)': (
+            'candidates = np.linspace(0.01, 0.99, 99)\n'
+            'top = np.abs(FeatureNormalizer(a=0.5).fit_transform(X)).max() / 0.5\n'
+            'a_max = float(candidates[1 - (candidates * top) ** 2 >= g_min].max())\n'
+            'margin_max = (1 - a_max) / (2 * a_max)\n'
+        ),
+        'a_max a little below the largest (0.002 under the formula)': (
+            'a_max = float(np.sqrt(1 - g_min)) - 0.002\nmargin_max = (1 - a_max) / (2 * a_max)\n'
+        ),
+        'a_max a little above the largest (the gradient at the extremes just under g_min)': (
+            'a_max = float(np.sqrt(1 - g_min)) + 1e-4\nmargin_max = (1 - a_max) / (2 * a_max)\n'
+        ),
     },
 }
