@@ -113,5 +113,23 @@ WRONG_ANSWERS = {
             'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
             'err_library = 2.0e-04 / 1000\n'
         ),
+        'so3_log of the float64 matrix, at 2.5e-4 (reader round 4)': (
+            'theta_bad = 2.5e-4\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(so3_exp(theta_bad * axis)))) - theta_bad)\n'
+        ),
+        'so3_log of the float64 matrix, at 1.1e-4 (reader round 4)': (
+            'theta_bad = 1.1e-4\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(so3_exp(theta_bad * axis)))) - theta_bad)\n'
+        ),
+        'the textbook formula in float64 arithmetic on the float32 matrix': (
+            'theta_bad = 2e-4\n'
+            'R32 = so3_exp(theta_bad * axis).astype(np.float32)\n'
+            'err_textbook = abs(float(np.arccos(np.clip((np.trace(R32.astype(np.float64)) - 1) / 2, -1, 1))) - theta_bad)\n'
+            'err_library = abs(float(np.linalg.norm(so3_log(R32))) - theta_bad)\n'
+        ),
     },
 }
