@@ -16,6 +16,7 @@ display      roundoff
 display      real_feature_table real_inference_table span_ceiling_table spiral_figure spiral_table
 models       course_model get_spec
 answer_rerun record_cells rerun_answer
+forbidden    LIBRARY_PCA forbidden_calls
 gradient_fits gradient_fit_stats
 prior_costs  one_dimension_cost prior_cost_figure
 table_row    FLOOR_COLUMN column_reconstructions

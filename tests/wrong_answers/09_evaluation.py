@@ -39,6 +39,20 @@ WRONG_ANSWERS = {
             'from meshvae_lib.model.evaluation import CoordinatePCA as Linear\n'
             'floor_mine = per_vertex_error(Linear(D).fit(V_train).reconstruct(V_test), V_test)\n'
         ),
+        'the library PCA through a course helper (column_reconstructions, the fresh reader\'s bypass)': (
+            'floor_mine = per_vertex_error(np.stack([column_reconstructions(m, V_train, D)["PCA on coordinates (floor)"]'
+            ' for m in V_test]), V_test)\n'
+        ),
+        'the library PCA in one region (regional_pca_baseline, the fresh reader\'s bypass)': (
+            'from meshvae_lib.model import regional_pca_baseline\n'
+            'floor_mine = np.array(regional_pca_baseline(V_train, V_test, np.zeros(V_train.shape[1], int), D)["per_mesh"])\n'
+        ),
+        "scikit-learn's PCA": (
+            'from sklearn.decomposition import PCA\n'
+            'p = PCA(D, svd_solver="full").fit(V_train.reshape(len(V_train), -1))\n'
+            'Y = p.inverse_transform(p.transform(V_test.reshape(len(V_test), -1)))\n'
+            'floor_mine = per_vertex_error(Y.reshape(V_test.shape), V_test)\n'
+        ),
     },
     2: {
         'copied from an earlier output (the means printed in section 2 typed in for every mesh)': (
@@ -71,6 +85,11 @@ WRONG_ANSWERS = {
         'the forbidden library call (per_vertex_error)': (
             "err_encoder = per_vertex_error(model.reconstruct(meshes, inference='encoder'), meshes)\n"
             "err_gn = per_vertex_error(model.reconstruct(meshes, inference='gauss-newton'), meshes)\n"
+        ),
+        'the forbidden library call, reached through a module that imported it (per_vertex_error)': (
+            'from meshvae_lib.applications import exploration\n'
+            "err_encoder = exploration.per_vertex_error(model.reconstruct(meshes, inference='encoder'), meshes)\n"
+            "err_gn = exploration.per_vertex_error(model.reconstruct(meshes, inference='gauss-newton'), meshes)\n"
         ),
     },
 }
