@@ -51,6 +51,12 @@ def test_relabelled_latents_decode_the_same_shapes_under_other_coordinates():
     assert relab.decode_latent(np.zeros((3, 4))).shape == (3, 40, 3)
     # the displacement over [-2, 2] is symmetric in the sign: relabelling permutes it
     np.testing.assert_allclose(ex.dimension_displacement(relab), ex.dimension_displacement(floor)[order], rtol=1e-9)
+    # encoding is the inverse map: a mesh's code decodes to what the model decodes of its own code
+    Z, W = relab.encode_meshes(V[:5]), floor.encode_meshes(V[:5])
+    assert Z.shape == (5, 4)
+    np.testing.assert_allclose(Z[:, 1], -W[:, 0], atol=1e-12)   # new axis 1 is the model's axis 0, flipped
+    np.testing.assert_allclose(relab.model_latents(Z), W, atol=1e-12)
+    np.testing.assert_allclose(relab.decode_latent(Z), floor.decode_latent(W), atol=1e-10)
     with pytest.raises(ValueError, match="permutation"):
         RelabelledLatents(floor, [0, 0, 1, 2])
     with pytest.raises(ValueError, match="signs"):

@@ -78,7 +78,8 @@ class RelabelledLatents:
     order : permutation of ``range(D)`` (default the identity)
     signs : (D,) of +1 / -1 (default all +1)
 
-    ``decode_latent(z)`` decodes the model's ``w`` with ``w[order[i]] = signs[i] * z[i]``; a prior
+    ``decode_latent(z)`` decodes the model's ``w`` with ``w[order[i]] = signs[i] * z[i]``, and
+    ``encode_meshes`` (where the model has it) maps the model's codes the other way; a prior
     ``N(0, I)`` and a box ``[-r, r]^D`` stay what they were, so browsing it is browsing the model.
     """
 
@@ -102,6 +103,16 @@ class RelabelledLatents:
     def decode_latent(self, z) -> np.ndarray:
         """Latent vectors ``(N, D)`` or ``(D,)`` in the new coordinates -> the model's meshes."""
         return self.model.decode_latent(self.model_latents(z))
+
+    def encode_meshes(self, vertices, *args, **kwargs):
+        """The model's ``encode_meshes`` (same arguments), in the new coordinates: codes ``(N, D)`` or
+        ``(D,)`` float64 with ``z[..., i] = signs[i] * w[..., order[i]]``, so that ``decode_latent``
+        of them decodes what the model decodes of its own ``w``. With ``return_sigma=True`` also the
+        posterior deviations, reordered (a deviation has no sign)."""
+        out = self.model.encode_meshes(vertices, *args, **kwargs)
+        W, sigma = out if isinstance(out, tuple) else (out, None)
+        Z = np.asarray(W, dtype=np.float64)[..., self.order] * self.signs
+        return Z if sigma is None else (Z, np.asarray(sigma, dtype=np.float64)[..., self.order])
 
 
 def grid_spread(grid: ExplorationGrid, reference_vertices=None) -> float:
