@@ -39,6 +39,30 @@ WRONG_ANSWERS = {
             'f_scaled = enc.transform(s * V1)\n'
             'rot_change = s_change = 1e-9\n'
         ),
+        'signed differences in the reversed order, f1 minus f_scaled, no abs (reader round 5)': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = float((f1[lay.rotation_slice] - f_scaled[lay.rotation_slice]).max())\n'
+            's_change = float((s * f1[lay.scaling_slice] - f_scaled[lay.scaling_slice]).max())\n'
+        ),
+        'rotation change as a signed difference in the reversed order, S change right (reader round 5)': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = float((f1[lay.rotation_slice] - f_scaled[lay.rotation_slice]).max())\n'
+            's_change = float(np.abs(f_scaled[lay.scaling_slice] - s * f1[lay.scaling_slice]).max())\n'
+        ),
+        'S change as a signed difference in the reversed order, rotation change right (reader round 5)': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = float(np.abs(f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
+            's_change = float((s * f1[lay.scaling_slice] - f_scaled[lay.scaling_slice]).max())\n'
+        ),
+        'signed differences in the natural order, f_scaled minus f1, no abs': (
+            's = 1.5\n'
+            'f_scaled = enc.transform(s * V1)\n'
+            'rot_change = float((f_scaled[lay.rotation_slice] - f1[lay.rotation_slice]).max())\n'
+            's_change = float((f_scaled[lay.scaling_slice] - s * f1[lay.scaling_slice]).max())\n'
+        ),
     },
     2: {
         'V_lin is the feature midpoint': (
