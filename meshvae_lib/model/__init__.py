@@ -13,7 +13,7 @@ EXPORTS = exports_of(__name__, """
 corrected_decoder       CorrectedLinearDecoder
 corrected_network       CorrectedVAE
 gram_pca                principal_directions
-evaluation              evaluate_model pca_baseline per_vertex_error regional_pca_baseline
+evaluation              evaluate_model pca_baseline per_vertex_error regional_pca_baseline CoordinatePCA
 feature_kinds           make_kind
 inference               make_inference
 inference.gauss_newton  FitState GaussNewton GaussNewtonReport LatentDecoder

@@ -318,7 +318,7 @@ class CorrectedLinearDecoder:
         opt.step(closure)
         return z.detach()
 
-    def _codes(self, X: np.ndarray) -> np.ndarray:
+    def _codes(self, X: np.ndarray, through_output: bool = True) -> np.ndarray:
         """:meth:`codes` without the checks."""
         import torch
 
@@ -329,7 +329,7 @@ class CorrectedLinearDecoder:
         C = torch.tensor((self._pre(X) - self.mean_) @ self.basis_.T / unit)
         with torch_threads(1):  # a small problem (see torch_threads)
             z = self._fit_coeff_codes(self.correction_, C, s, r, energy)
-        if self.output == "tanh":  # the pre-activations' fit is the start of the rows' own fit
+        if self.output == "tanh" and through_output:  # the pre-activations' fit starts the rows' own fit
             z = self._fit_output_codes(z, torch.tensor(X), s, r)
         return torch.nn.functional.pad(z, (0, D - z.shape[1])).numpy()
 
@@ -364,16 +364,16 @@ class CorrectedLinearDecoder:
         check_is_fitted(self, "report_")
         return self.report_.kept
 
-    def codes(self, X) -> np.ndarray:
+    def codes(self, X, through_output: bool = True) -> np.ndarray:
         """Whitened codes ``(M, D)`` float64 of rows ``X (M, K)``: the projection of their
         pre-activations onto the D principal directions, refined through the correction where it was
-        kept, and for a tanh output fitted to the rows themselves through the tanh (held-out rows
-        beyond [-1, 1] are clipped to ``TANH_ROW_CLIP`` for the projection only)."""
+        kept, and for a tanh output (unless ``through_output`` is False) fitted to the rows themselves
+        through the tanh (held-out rows beyond [-1, 1] are clipped to ``TANH_ROW_CLIP`` for the projection only)."""
         check_is_fitted(self, "report_")
         X = self._rows(X, "X")
         if X.shape[1] != self.n_features_in_:
             raise ValueError(f"rows must have {self.n_features_in_} components, got {X.shape[1]}")
-        return self._codes(X)
+        return self._codes(X, through_output)
 
     def decode(self, Z) -> np.ndarray:
         """Rows ``(M, K)`` float64 of codes ``Z (M, D)`` (through the tanh for a tanh output)."""
