@@ -342,8 +342,9 @@ def run(args) -> int:
                          f" --hidden {' '.join(map(str, hidden)) or '(none)'}, --latent {args.latent or 'auto'});"
                          f" the limit is {MAX_NETWORK_PARAMETERS:,}: choose smaller --hidden or --latent")
     at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
+    epochs = "" if network.trains_in_start else f", hidden {list(hidden)}, {at_most}{config.epochs} epochs"
     note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, network {args.architecture},"
-         f" features {args.features}, latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{config.epochs} epochs")
+         f" features {args.features}, latent {args.latent or 'auto'}{epochs}")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference)
     try:
