@@ -125,9 +125,9 @@ def main(argv=None) -> int:
             row = run(name, D, args)
             if row is not None:
                 rows.append(row)
-    if args.json:
-        Path(args.json).write_text(json.dumps({"args": vars(args), "rows": rows}, indent=1))
-        Path(args.json).with_suffix(".md").write_text(markdown(rows))
+            if args.json:  # after every row: an interrupted run keeps what it measured
+                Path(args.json).write_text(json.dumps({"args": vars(args), "rows": rows}, indent=1))
+                Path(args.json).with_suffix(".md").write_text(markdown(rows))
     return 0
 
 
