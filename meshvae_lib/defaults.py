@@ -30,6 +30,9 @@ LOSSES = ("mse", "bce", "l1")
 POSITION_KINDS = ("coords", "aligned")
 #: network initialisations (``train_config.TrainConfig.init``) and the default.
 INIT_MODES = ("pca", "random")
+#: ``meshvae train --decoder``: auto (the corrected decoder below the training rank, else the linear
+#: one), linear (the mesh VAE at its PCA start), corrected (``architecture="corrected"``).
+DECODERS = ("auto", "linear", "corrected")
 DEFAULT_INIT = "pca"
 #: reconstruction methods and rotation recovery (``reconstruction.RIMDReconstructor``).
 RECONSTRUCTION_METHODS = ("exact", "paper")

@@ -7,7 +7,7 @@ import dataclasses
 import logging
 import re
 
-from meshvae_lib.defaults import DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
+from meshvae_lib.defaults import DECODERS, DEFAULT_ARCHITECTURE, DEFAULT_FEATURE_KIND, DEFAULT_INIT, INIT_MODES, PRIOR_FORMS
 from meshvae_lib.defaults import DEFAULT_ALPHA, DEFAULT_BATCH_SIZE, DEFAULT_EPOCHS, DEFAULT_LATENT, DEFAULT_LR, PCA_LATENT_MAX
 from meshvae_lib.defaults import MAX_EPOCHS, MAX_NETWORK_PARAMETERS
 from meshvae_lib.model.feature_kinds import FEATURE_KINDS
@@ -201,6 +201,48 @@ def _network_choices(args, network) -> tuple[int, ...]:
     return ()
 
 
+def _decoder_architecture(args, n_train: int) -> str:
+    """The architecture ``--decoder`` picks for ``n_train`` training meshes: "corrected" when asked,
+    or by default where the linear start is no longer the optimum (a ``--latent`` below the training
+    rank, n_train - 1) and the mesh VAE would start at its PCA (no other ``--architecture``, no
+    ``--init random``, ``--hidden``, ``--labels``, ``--sigma-object`` or ``--no-early-stopping``);
+    else ``--architecture``."""
+    if args.decoder == "corrected":
+        return "corrected"
+    linear_start = (args.architecture == DEFAULT_ARCHITECTURE and args.init == "pca" and not args.hidden
+                    and not args.labels and args.sigma_object is None and not args.no_early_stopping)
+    if args.decoder == "auto" and linear_start and args.latent is not None and args.latent < n_train - 1:
+        return "corrected"
+    return args.architecture
+
+
+def _check_decoder(args) -> None:
+    """``--decoder`` against ``--architecture`` (UsageError where they contradict); ``--decoder
+    corrected`` sets the architecture."""
+    if args.decoder != "auto" and args.architecture not in (DEFAULT_ARCHITECTURE, "corrected"):
+        raise UsageError(f"--decoder {args.decoder} chooses the mesh VAE's decoder; --architecture {args.architecture}"
+                         " has its own")
+    if args.decoder == "linear" and args.architecture == "corrected":
+        raise UsageError("--decoder linear contradicts --architecture corrected")
+    if args.decoder == "corrected":
+        args.architecture = "corrected"
+
+
+def _chosen_decoder(args, n_train: int, network, config, flags: dict):
+    """The network class and the config once the training meshes are counted (``n_train``): the
+    corrected decoder where :func:`_decoder_architecture` picks it, else unchanged."""
+    from meshvae_lib.model.networks import network_class
+
+    chosen = _decoder_architecture(args, n_train)
+    if chosen == args.architecture:
+        return network, config
+    args.architecture = chosen
+    try:
+        return network_class(chosen), dataclasses.replace(config, architecture=chosen)
+    except ValueError as exc:
+        raise UsageError(_option_names(str(exc), flags)) from None
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = add_command(subparsers, "train", "train a mesh VAE and save a checkpoint", DESCRIPTION, run)
     p.__class__ = _TrainParser     # the networks' flags on first parse: they import torch
@@ -218,6 +260,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--init", choices=INIT_MODES, default=DEFAULT_INIT,
                    help="pca (default): start from the PCA of the training features (networks without internal"
                         " layers, standard prior, no labels; docs/vae.md); random: PyTorch's initialisation (the paper)")
+    p.add_argument("--decoder", choices=DECODERS, default="auto",
+                   help="auto (default): with --latent below the training meshes' rank (training meshes - 1), the"
+                        " corrected decoder (the linear decoder plus a correction kept only where it lowers the error"
+                        " of validation meshes; docs/results/nonlinearity.md), else the linear decoder; linear: the"
+                        " mesh VAE without internal layers at its PCA start; corrected: always the corrected decoder")
     p.add_argument("--no-early-stopping", action="store_true",
                    help="train all --epochs instead of choosing them on every 8th training mesh")
     p.add_argument("--alpha", type=float, default=DEFAULT_ALPHA, metavar="A",
@@ -246,7 +293,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     from meshvae_lib.model.meshvae_model import MeshVAEModel
-    from meshvae_lib.model.training import TrainingDiverged
+    from meshvae_lib.model.training import TrainingDiverged, holdout_mask
     from meshvae_lib.model.evaluation import evaluate_model
     from meshvae_lib.geometry.collection_io import read_collection
     from meshvae_lib.model.train_config import TrainConfig
@@ -269,6 +316,7 @@ def run(args) -> int:
     check_seed(args.seed)
     _check_device(args.device)
     check_output(args.output)  # its folder must exist, as for every command's -o
+    _check_decoder(args)
     network = network_class(args.architecture)
     hidden = _network_choices(args, network)
     options, flags = _network_options(args, network)
@@ -284,6 +332,8 @@ def run(args) -> int:
     if not -len(collection) <= args.reference < len(collection):
         raise UsageError(f"--reference {args.reference} is out of range for {len(collection)} meshes"
                          f" (0..{len(collection) - 1})")
+    network, config = _chosen_decoder(args, len(collection) - int(holdout_mask(len(collection), args.holdout_every).sum()),
+                                      network, config, flags)
     n_features = (3 * collection.n_vertices if args.features != "rimd"
                   else 6 * collection.n_vertices + 9 * len(collection.faces))  # RIMD: 6V + 6E, E <= 3F/2
     n_params = network.weights_estimate(n_features, config)
@@ -292,8 +342,9 @@ def run(args) -> int:
                          f" --hidden {' '.join(map(str, hidden)) or '(none)'}, --latent {args.latent or 'auto'});"
                          f" the limit is {MAX_NETWORK_PARAMETERS:,}: choose smaller --hidden or --latent")
     at_most = "at most " if config.resolved_early_stopping(len(args.labels)) else ""
+    epochs = "" if network.trains_in_start else f", hidden {list(hidden)}, {at_most}{config.epochs} epochs"
     note(f"training on {len(collection)} meshes of {collection.n_vertices} vertices, network {args.architecture},"
-         f" features {args.features}, latent {args.latent or 'auto'}, hidden {list(hidden)}, {at_most}{config.epochs} epochs")
+         f" features {args.features}, latent {args.latent or 'auto'}{epochs}")
     model = MeshVAEModel(features=args.features, config=config, labels=args.labels,
                          holdout_every=args.holdout_every, reference_index=args.reference)
     try:
@@ -304,7 +355,9 @@ def run(args) -> int:
         raise UsageError(_small_mesh(_option_names(str(exc), flags), args, collection)) from exc
     model.save(args.output)
     last = model.history_[-1]
-    if model.selection_ is not None and "skipped" in model.selection_:
+    if args.architecture == "corrected":
+        result(f"decoder: {model.network.describe()} ({model.network.choice})")
+    elif model.selection_ is not None and "skipped" in model.selection_:
         result(f"no epoch search, the model is the PCA start: {model.selection_['skipped']}")
     elif model.selection_ is not None:
         result(f"early stopping on {len(model.selection_['validation_rows'])} training meshes chose"

@@ -11,8 +11,9 @@ from meshvae_lib.exports import exports_of, lazy_exports
 #: module (under this package) and the public names it defines, one line each.
 EXPORTS = exports_of(__name__, """
 corrected_decoder       CorrectedLinearDecoder
+corrected_network       CorrectedVAE
 gram_pca                principal_directions
-evaluation              evaluate_model pca_baseline per_vertex_error regional_pca_baseline
+evaluation              evaluate_model pca_baseline per_vertex_error regional_pca_baseline CoordinatePCA
 feature_kinds           make_kind
 inference               make_inference
 inference.gauss_newton  FitState GaussNewton GaussNewtonReport LatentDecoder

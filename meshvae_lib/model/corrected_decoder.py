@@ -36,6 +36,7 @@ from meshvae_lib.defaults import (CORRECTION_CHECK_EVERY, CORRECTION_CODE_PRIOR,
                                   CORRECTION_WEIGHT_DECAY)
 from meshvae_lib.model.correction_choice import CorrectionReport, checked_scores, gain_lower_bound
 from meshvae_lib.model.gram_pca import principal_directions
+from meshvae_lib.model.threads import torch_threads
 from meshvae_lib.tolerances import CODE_FIT_CHANGE_TOL, CODE_FIT_GRAD_TOL, TANH_ROW_CLIP
 from meshvae_lib.validation import check_is_fitted
 
@@ -175,7 +176,8 @@ class CorrectedLinearDecoder:
         energy = float(np.mean(np.sum(C_fit ** 2, axis=1)))
         linear_val = float(np.mean(np.sum(C_val[:, D:] ** 2, axis=1))) * unit ** 2 + out_val
 
-        net, best, best_step, best_state, step, curve = self._train(C_fit, C_val, scale, unit, energy, out_val)
+        with torch_threads(1):  # thousands of small steps: one thread (see torch_threads)
+            net, best, best_step, best_state, step, curve = self._train(C_fit, C_val, scale, unit, energy, out_val)
         report = dict(linear_validation=linear_val, corrected_validation=float(best), best_step=best_step,
                       steps=step, n_fit=n_fit, n_validation=n_val, curve=curve)
         if best_state is None:
@@ -265,9 +267,7 @@ class CorrectedLinearDecoder:
 
     def _pre(self, X: np.ndarray) -> np.ndarray:
         """The rows' pre-activations: ``atanh`` of rows clipped into (-1, 1) for a tanh output."""
-        if self.output == "tanh":
-            return np.arctanh(np.clip(X, -TANH_ROW_CLIP, TANH_ROW_CLIP))
-        return X
+        return np.arctanh(np.clip(X, -TANH_ROW_CLIP, TANH_ROW_CLIP)) if self.output == "tanh" else X
 
     def _keep_linear(self, Y: np.ndarray, report: CorrectionReport) -> None:
         self.mean_, self.basis_, self.scale_ = principal_directions(Y, int(self.latent_dim))
@@ -318,7 +318,7 @@ class CorrectedLinearDecoder:
         opt.step(closure)
         return z.detach()
 
-    def _codes(self, X: np.ndarray) -> np.ndarray:
+    def _codes(self, X: np.ndarray, through_output: bool = True) -> np.ndarray:
         """:meth:`codes` without the checks."""
         import torch
 
@@ -327,8 +327,9 @@ class CorrectedLinearDecoder:
         s = torch.tensor(self.scale_[:d] / unit)
         energy = float(np.sum((self.scale_ / unit) ** 2))
         C = torch.tensor((self._pre(X) - self.mean_) @ self.basis_.T / unit)
-        z = self._fit_coeff_codes(self.correction_, C, s, r, energy)
-        if self.output == "tanh":  # the pre-activations' fit is the start of the rows' own fit
+        with torch_threads(1):  # a small problem (see torch_threads)
+            z = self._fit_coeff_codes(self.correction_, C, s, r, energy)
+        if self.output == "tanh" and through_output:  # the pre-activations' fit starts the rows' own fit
             z = self._fit_output_codes(z, torch.tensor(X), s, r)
         return torch.nn.functional.pad(z, (0, D - z.shape[1])).numpy()
 
@@ -363,21 +364,19 @@ class CorrectedLinearDecoder:
         check_is_fitted(self, "report_")
         return self.report_.kept
 
-    def codes(self, X) -> np.ndarray:
+    def codes(self, X, through_output: bool = True) -> np.ndarray:
         """Whitened codes ``(M, D)`` float64 of rows ``X (M, K)``: the projection of their
         pre-activations onto the D principal directions, refined through the correction where it was
-        kept, and for a tanh output fitted to the rows themselves through the tanh (held-out rows
-        beyond [-1, 1] are clipped to ``TANH_ROW_CLIP`` for the projection only)."""
+        kept, and for a tanh output (unless ``through_output`` is False) fitted to the rows themselves
+        through the tanh (held-out rows beyond [-1, 1] are clipped to ``TANH_ROW_CLIP`` for the projection only)."""
         check_is_fitted(self, "report_")
         X = self._rows(X, "X")
         if X.shape[1] != self.n_features_in_:
             raise ValueError(f"rows must have {self.n_features_in_} components, got {X.shape[1]}")
-        return self._codes(X)
+        return self._codes(X, through_output)
 
     def decode(self, Z) -> np.ndarray:
         """Rows ``(M, K)`` float64 of codes ``Z (M, D)`` (through the tanh for a tanh output)."""
-        import torch
-
         check_is_fitted(self, "report_")
         Z = self._rows(Z, "Z")
         D = int(self.latent_dim)

@@ -66,6 +66,8 @@ class Network(nn.Module):
       takes ``TrainConfig.hidden``.
     - ``pca_start``: whether it starts at the PCA of its rows (``TrainConfig.uses_pca_init``);
       ``linear_optimum``: None, or why its start is its optimum (the epoch search is skipped).
+    - ``trains_in_start``: whether ``start`` does all its training (the trainer then trains no epoch,
+      with or without early stopping, and refuses to continue training it).
     """
 
     architecture: ClassVar[str] = ""
@@ -78,6 +80,7 @@ class Network(nn.Module):
     takes_hidden: ClassVar[bool] = False
     pca_start: ClassVar[bool] = False
     linear_optimum: ClassVar[str | None] = None
+    trains_in_start: ClassVar[bool] = False
 
     n_features: int
     latent_dim: int

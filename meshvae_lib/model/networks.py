@@ -33,6 +33,7 @@ ARCHITECTURES = {
     "mesh-vae": "meshvae_lib.model.vae:MeshVAE",
     "spiral": "meshvae_lib.model.spiral_net:SpiralVAE",
     "local-parts": "meshvae_lib.model.local_parts:LocalPartsVAE",
+    "corrected": "meshvae_lib.model.corrected_network:CorrectedVAE",
 }
 #: the registered architectures' names when this module was imported (use ``tuple(ARCHITECTURES)``
 #: for the current ones).

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import logging
 import os
+from contextlib import contextmanager
 
-__all__ = ["ENV_VAR", "configure_threads", "threads_from_environment"]
+__all__ = ["ENV_VAR", "configure_threads", "threads_from_environment", "torch_threads"]
 
 logger = logging.getLogger(__name__)
 
@@ -74,3 +75,25 @@ def configure_threads(default: int = 2) -> int:
     threadpool_limits(limits=n, user_api="blas")  # numpy's / scipy's BLAS, for the rest of the process
     logger.debug("torch and BLAS threads: %d", n)
     return n
+
+
+@contextmanager
+def torch_threads(n: int):
+    """torch's intra-op thread count set to ``n`` (>= 1) inside the ``with`` block, restored after.
+
+    For many small operations (a network of a few hundred units on a few hundred rows, thousands of
+    steps) one thread is faster than several: each operation is too small to split, and on a busy
+    machine the threads wait for each other (measured: an Adam step of a 4-128-128-36 network on 40
+    rows took 1.8 ms on one thread and 61 ms on two, with other work on both cores). The results do
+    not depend on the thread count of the caller then.
+    """
+    import torch
+
+    if int(n) < 1:
+        raise ValueError(f"thread count must be >= 1, got {n!r}")
+    before = torch.get_num_threads()
+    torch.set_num_threads(int(n))
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)

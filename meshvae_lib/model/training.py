@@ -179,6 +179,8 @@ def _epochs(model, x, c, loss: _Loss, epochs: int, device, desc: str):
     the progress bar). Raises :class:`TrainingDiverged` on a non-finite loss."""
     config = loss.config
     n = x.shape[0]
+    if not epochs:  # nothing to train (a network without weights to train may have no parameters)
+        return
     optimizer = torch.optim.Adam(model.parameters(), lr=config.lr, fused=True)
     shuffle_gen = torch.Generator().manual_seed(config.seed + 1)
     noise_gen = torch.Generator(device=device).manual_seed(config.seed + 2)
@@ -309,10 +311,9 @@ def start_is_optimum(config: TrainConfig, n_rows: int, n_conditions: int) -> boo
 
 
 def _skip_reason(config: TrainConfig, n_rows: int, n_conditions: int) -> str | None:
-    """Why a new network's start is kept untrained (see :func:`start_is_optimum`; ``config``
-    resolved), or None: the
-    span rule's :data:`START_IS_OPTIMUM`, or the class's own ``linear_optimum`` (the local-parts
-    network's, whose every region starts at its own optimum whatever the latent size)."""
+    """Why a new network's start is kept untrained (``config`` resolved; see :func:`start_is_optimum`),
+    or None: the span rule's :data:`START_IS_OPTIMUM`, or the class's own ``linear_optimum`` (the
+    local-parts network's: every region starts at its own optimum whatever the latent size)."""
     if config.early_stopping is not None or not config.uses_pca_init(n_conditions):
         return None
     own = network_class(config.architecture).linear_optimum
@@ -337,10 +338,10 @@ def train_vae(
     features : (N, K) float, normalised (Eq. 3), N >= 2.
     conditions : (N, C) float or None (conditional mesh VAE, Eq. 5).
     config : TrainConfig (defaults when None): the network is ``config.architecture``'s ``start``
-        (for the mesh VAE with ``init="pca"``, the default, a network without internal layers
-        starts at the PCA of the rows, :meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`), and the
-        number of epochs is chosen by early stopping on every ``validation_every``-th training row
-        (see :class:`TrainConfig`).
+        (the mesh VAE with ``init="pca"``, the default, starts at the PCA of the rows,
+        :meth:`~meshvae_lib.model.vae.MeshVAE.from_pca`), and the number of epochs is chosen by early
+        stopping on every ``validation_every``-th training row (see :class:`TrainConfig`); none for a
+        network that ``trains_in_start``.
     val_features, val_conditions : (M, K), (M, C) held-out rows, optional: only recorded in the
         history (``val_*``), never used to choose anything.
     model : continue training this network instead of building a new one (no PCA initialisation
@@ -352,20 +353,17 @@ def train_vae(
     function that resolves a configuration; the estimator has already applied it) before the
     network's ``start``; continuing ``model``, the latent size is the model's.
 
-    Returns
-    -------
-    TrainResult with the network (eval mode, CPU), the per-epoch history, the number of epochs and
-    early stopping's record.
+    Returns a TrainResult: the network (eval mode, CPU), the per-epoch history, the number of epochs
+    and early stopping's record.
     """
     config = config or TrainConfig()
     x, c, xv, cv = _rows(features, conditions, val_features, val_conditions)
     n, k = x.shape
     n_cond = 0 if c is None else c.shape[1]
     config = config.resolve(n, n_cond)                  # explicit options kept: the estimator's is unchanged
-    if model is not None:
-        config = replace(config, latent_dim=model.latent_dim)
     device = resolve_device(config.device)
     if model is not None:
+        config = replace(config, latent_dim=model.latent_dim)
         _check_given(model, k, n_cond, config)
     early = model is None and config.resolved_early_stopping(n_cond) and n >= 2 * config.validation_every
     so = pad_sigma_object(config.sigma_object, config.latent_dim)
@@ -374,7 +372,10 @@ def train_vae(
 
     t0 = time.perf_counter()
     epochs, selection = config.epochs, None
-    skipped = _skip_reason(config, n, n_cond) if early else None
+    own = network_class(config.architecture)
+    if own.trains_in_start and model is not None:
+        raise ValueError(f"the {own.architecture} network is trained in its start; it cannot be trained further")
+    skipped = own.linear_optimum if own.trains_in_start else _skip_reason(config, n, n_cond) if early else None
     if skipped:
         epochs, selection = 0, {"epochs": 0, "skipped": skipped}
         logger.info("no epoch search: %s", skipped)
