@@ -12,6 +12,7 @@ from meshvae_lib.exports import exports_of, lazy_exports
 EXPORTS = exports_of(__name__, """
 generation     mix_parts parts_code
 interpolation  edge_length_distortion vertex_edge_stretch
+exploration_checks  WhitenedPCA RelabelledLatents grid_spread
 """)
 
 __all__ = sorted(EXPORTS)
