@@ -40,6 +40,13 @@ def test_a_class_raises_through_a_helper_that_imported_it():
         with pytest.raises(AssertionError, match="no PCA"):
             from sklearn.decomposition import PCA
             PCA(2).fit(V[:5].reshape(5, -1))
+        from sklearn.decomposition import IncrementalPCA, KernelPCA, TruncatedSVD
+        from sklearn.utils.extmath import randomized_svd
+        X = V[:5].reshape(5, -1)
+        for make in (lambda: IncrementalPCA(2).fit(X), lambda: TruncatedSVD(2).fit(X - X.mean(axis=0)),
+                     lambda: KernelPCA(2).fit(X), lambda: randomized_svd(X, 2)):
+            with pytest.raises(AssertionError, match="no PCA"):   # every scikit-learn route to principal directions
+                make()
         np.linalg.svd(V[0])   # numpy itself stays allowed
     after = column_reconstructions(V[5], V[:5], 2)
     assert all(np.array_equal(after[k], expected[k]) for k in expected)

@@ -18,7 +18,11 @@ from unittest import mock
 __all__ = ["LIBRARY_PCA", "forbidden_calls"]
 
 #: every principal component analysis the course's environment ships: the library's linear floor
-#: (and the course helpers built on it), its PCA starts and scikit-learn's PCA.
+#: (and the course helpers built on it), its PCA starts, and scikit-learn's estimators that find
+#: principal directions (``PCA``, ``IncrementalPCA``, ``TruncatedSVD`` -- PCA once the rows are
+#: centred --, ``KernelPCA``, ``SparsePCA``, ``MiniBatchSparsePCA``) with its truncated SVD
+#: ``randomized_svd``. numpy's and scipy's SVD and eigendecompositions stay allowed: they are the
+#: tools of PCA by hand.
 LIBRARY_PCA = (
     "meshvae_lib.model.evaluation.CoordinatePCA",
     "meshvae_lib.model.evaluation.pca_baseline",
@@ -27,6 +31,12 @@ LIBRARY_PCA = (
     "meshvae_lib.model.pca_start.pca_start",
     "meshvae_lib.model.pca_start.regional_pca_start",
     "sklearn.decomposition.PCA",
+    "sklearn.decomposition.IncrementalPCA",
+    "sklearn.decomposition.TruncatedSVD",
+    "sklearn.decomposition.KernelPCA",
+    "sklearn.decomposition.SparsePCA",
+    "sklearn.decomposition.MiniBatchSparsePCA",
+    "sklearn.utils.extmath.randomized_svd",
 )
 
 

@@ -53,6 +53,18 @@ WRONG_ANSWERS = {
             'Y = p.inverse_transform(p.transform(V_test.reshape(len(V_test), -1)))\n'
             'floor_mine = per_vertex_error(Y.reshape(V_test.shape), V_test)\n'
         ),
+        "scikit-learn's IncrementalPCA (one exact SVD at its default batch; the fresh reader's bypass)": (
+            'from sklearn.decomposition import IncrementalPCA\n'
+            'p = IncrementalPCA(D).fit(V_train.reshape(len(V_train), -1))\n'
+            'Y = p.inverse_transform(p.transform(V_test.reshape(len(V_test), -1)))\n'
+            'floor_mine = per_vertex_error(Y.reshape(V_test.shape), V_test)\n'
+        ),
+        "scikit-learn's TruncatedSVD on the centred rows (the fresh reader's bypass)": _PCA_BY_HAND + (
+            'from sklearn.decomposition import TruncatedSVD\n'
+            'directions = TruncatedSVD(D, algorithm="arpack").fit(X - mean).components_\n'
+            'Y = V_test.reshape(len(V_test), -1) - mean\n'
+            'floor_mine = per_vertex_error((mean + Y @ directions.T @ directions).reshape(V_test.shape), V_test)\n'
+        ),
     },
     2: {
         'copied from an earlier output (the means printed in section 2 typed in for every mesh)': (
