@@ -347,6 +347,18 @@ def test_a_static_page_shows_the_interpolation_along_t(sphere):
     assert s.t == 0.0 and w >= 6 * 150, f"a readable strip, got {w}x{h} px"
 
 
+def test_the_sliders_static_strip_takes_the_panel_size_asked_for(sphere):
+    from meshvae_lib.defaults import STATIC_DPI
+
+    V, F = sphere
+    w, h = _png_size(InterpolationSlider(V, 2 * V, F, mode="threejs", static_size=2.6).static_png())
+    assert w >= 6 * 2.6 * STATIC_DPI - 20 and h >= 2.6 * STATIC_DPI, f"6 panels of 2.6 inches, got {w}x{h} px"
+    w_default, _ = _png_size(InterpolationSlider(V, 2 * V, F, mode="threejs").static_png())
+    assert w_default < w, "the default strip is the smaller one"
+    with pytest.raises(ValueError, match="static_size"):
+        InterpolationSlider(V, 2 * V, F, mode="threejs", static_size=0)
+
+
 def test_the_players_static_strip_takes_the_panel_size_asked_for(sphere):
     from meshvae_lib.defaults import STATIC_DPI
 

@@ -196,14 +196,20 @@ class InterpolationSlider(_Displayable):
         Show ``V_a`` and ``V_b`` left and right of the interpolated mesh.
     step : float
     continuous_update : bool
+    static_size : float
+        Inches per panel of :meth:`static_png`, the strip a page without widgets shows (default
+        ``defaults.STATIC_PANEL_INCHES``).
     **viewer_kw
         Passed to :class:`MeshViewer`.
     """
 
     def __init__(self, V_a, V_b, F, interpolate=None, show_ends: bool = True, step: float = 0.02,
-                 continuous_update: bool = True, **viewer_kw):
+                 continuous_update: bool = True, static_size: float = STATIC_PANEL_INCHES, **viewer_kw):
         import ipywidgets as W
 
+        if not static_size > 0:
+            raise ValueError(f"static_size must be positive, got {static_size}")
+        self.static_size = float(static_size)
         A = as_mesh_stack(V_a, n_meshes=1)[0]
         B = as_mesh_stack(V_b, n_meshes=1, n_vertices=len(A))[0]
         self._A, self._B = A, B
@@ -249,7 +255,7 @@ class InterpolationSlider(_Displayable):
         ts = np.linspace(0.0, 1.0, STATIC_STRIP_FRAMES)
         return figure_to_png(render_mesh_grid([self.mesh_at(t) for t in ts], self.viewer.F,
                                               titles=[f"t = {t:.1f}" for t in ts], ncols=len(ts),
-                                              size=STATIC_PANEL_INCHES, dpi=STATIC_DPI))
+                                              size=self.static_size, dpi=STATIC_DPI))
 
     def __repr__(self) -> str:
         return f"InterpolationSlider({self.viewer.n_vertices} vertices, mode={self.viewer.mode!r})"
