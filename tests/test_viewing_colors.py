@@ -36,6 +36,18 @@ def test_scalar_colors_clip_and_share_one_range_across_meshes():
     assert (m2.vmin, m2.vmax) == (0.0, 10.0)
 
 
+def test_show_clipped_names_the_ends_that_values_lie_past():
+    v = np.array([[-1.0, 1.0], [2.0, 10.0]])
+    assert scalar_colors(v, vmin=0.0, vmax=2.0)[1].extend == "neither"           # off by default
+    assert scalar_colors(v, vmin=0.0, vmax=2.0, show_clipped=True)[1].extend == "both"
+    assert scalar_colors(v, vmin=-1.0, vmax=2.0, show_clipped=True)[1].extend == "max"
+    assert scalar_colors(v, vmin=0.0, vmax=10.0, show_clipped=True)[1].extend == "min"
+    assert scalar_colors(v, show_clipped=True)[1].extend == "neither"              # the full range clips nothing
+    P = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0]])
+    assert error_colors(P, np.zeros((2, 3)), vmax=2.0, show_clipped=True)[1].extend == "max"
+    assert error_colors(P, np.zeros((2, 3)), vmax=3.0, show_clipped=True)[1].extend == "neither"
+
+
 def test_constant_values_and_nan_give_finite_colours():
     C, m = scalar_colors(np.full(5, 3.0))
     assert np.all(np.isfinite(C))

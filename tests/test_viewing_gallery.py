@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from meshvae_lib.course.display import roundoff
-from meshvae_lib.viewing.gallery import angular_stripes, gallery_indices, mesh_caption
+from meshvae_lib.viewing.gallery import align_on_part, angular_stripes, gallery_indices, mesh_caption
 
 
 def test_evenly_spaced_without_groups():
@@ -52,3 +52,26 @@ def test_roundoff_prints_a_bound_below_it_and_digits_above():
     assert roundoff(3.24e-4) == "3.2e-04"
     with pytest.raises(ValueError, match="below must be > 0, got 0"):
         roundoff(1.0, 0)
+
+
+def test_align_on_part_undoes_the_part_s_turn_and_keeps_the_rest_s_own_motion():
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(3)
+    ref = rng.normal(size=(40, 3))
+    part = np.arange(40) < 25                         # these move rigidly; the others also deform
+    turn = Rotation.from_rotvec(np.radians(25.0) * np.array([0.6, 0.8, 0.0]))
+    own = np.zeros_like(ref)
+    own[~part] = 0.1 * rng.normal(size=((~part).sum(), 3))    # the rest's own motion
+    moved = turn.apply(ref + own) + np.array([1.0, -2.0, 0.5])
+    aligned, deg = align_on_part(np.stack([moved, ref]), ref, part)
+    assert np.allclose(deg, [25.0, 0.0], atol=1e-6)
+    assert np.allclose(aligned[0, part], ref[part], atol=1e-9)
+    assert np.allclose(aligned[0], ref + own, atol=1e-9)      # the own motion stays, the turn goes
+    assert np.allclose(aligned[1], ref, atol=1e-9)
+    one, one_deg = align_on_part(moved, ref, part)
+    assert one.shape == (40, 3) and np.isclose(one_deg, 25.0, atol=1e-6)
+    with pytest.raises(ValueError, match="part must be"):
+        align_on_part(moved, ref, np.ones(40))
+    with pytest.raises(ValueError, match="part must be"):
+        align_on_part(moved, ref, np.arange(40) < 2)

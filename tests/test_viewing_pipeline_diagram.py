@@ -35,3 +35,14 @@ def test_every_text_is_readable_at_the_saved_size():
     assert min(t.get_fontsize() for t in fig.axes[0].texts) >= 9
     with pytest.raises(ValueError, match="at least 9 points"):
         pipeline_diagram(fontsize=7)
+
+
+def test_the_notebooks_named_for_collection_io_are_those_that_read_collections():
+    from pathlib import Path
+
+    notebooks = Path(__file__).resolve().parents[1] / "notebooks"
+    readers = {p.name[:2] for p in notebooks.glob("[0-9][0-9]_*.ipynb")
+               if "read_collection" in p.read_text() or "collection_io" in p.read_text()}
+    first = ENCODER_SIDE[0]
+    assert "collection_io" in first.module
+    assert {s.strip() for s in first.notebook.split(",")} - {"00"} == readers   # 00 shows data_synth

@@ -119,6 +119,10 @@ def test_render_mesh_grid_layout_titles_colorbar_and_png(sphere):
     mesh_axes = [ax for ax in fig.axes if ax.get_title()]
     assert [ax.get_title() for ax in mesh_axes] == ["a", "b", "c"]
     assert len(fig.axes) == 4  # 3 panels + the colour bar
+    assert fig.axes[-1]._colorbar.extend == "neither"
+    C, m, _ = error_colors(meshes, V, vmax=0.1, show_clipped=True)   # values past the scale: a triangle at its top
+    clipped = render_mesh_grid(meshes, F, titles=["a", "b", "c"], ncols=2, colors=C, colorbar=m)
+    assert clipped.axes[-1]._colorbar.extend == "max"
     png = figure_to_png(fig)
     assert png[:4] == b"\x89PNG"
     assert 0.15 < _drawn(png) < 0.9

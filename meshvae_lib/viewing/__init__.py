@@ -15,7 +15,8 @@ module                      public names
                             ``label_colors``, ``colorbar_html``, ``legend_html``
 ``render``                  ``render_mesh``, ``render_mesh_grid``, ``figure_to_png``
 ``fallback``                ``resolve_mode``, ``ImageView``
-``gallery``                 ``gallery_indices``, ``mesh_caption``, ``angular_stripes``
+``gallery``                 ``gallery_indices``, ``mesh_caption``, ``angular_stripes``,
+                            ``align_on_part``
 ``viewer``                  ``MeshViewer``
 ``widgets``                 ``FramePlayer``, ``InterpolationSlider``
 ``explorer``                ``LatentExplorer``
@@ -46,7 +47,7 @@ from meshvae_lib.viewing.readable_figure import readable_figure
 EXPORTS = exports_of(__name__, """
 buffers                 position_buffer normal_buffer index_buffer color_buffer row_offsets fit_camera
 colors                  ColorMapping scalar_colors error_colors label_colors colorbar_html legend_html
-gallery                 gallery_indices mesh_caption angular_stripes
+gallery                 gallery_indices mesh_caption angular_stripes align_on_part
 render                  render_mesh render_mesh_grid figure_to_png
 fallback                resolve_mode ImageView
 viewer                  MeshViewer

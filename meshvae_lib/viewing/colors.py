@@ -50,12 +50,16 @@ class ColorMapping:
         Values mapped to the two ends of the colour map (values outside are clipped).
     label : str
         What the values mean (shown next to the colour bar), e.g. ``"error (% of diagonal)"``.
+    extend : str
+        ``"neither"``, ``"min"``, ``"max"`` or ``"both"``: which ends clipped values past them (a colour
+        bar draws a triangle there, as matplotlib's ``extend``).
     """
 
     cmap: str
     vmin: float
     vmax: float
     label: str = ""
+    extend: str = "neither"
 
     def __call__(self, values) -> np.ndarray:
         """Map values ``(...,)`` float to RGB ``(..., 3) float32``; NaN maps to mid grey."""
@@ -76,7 +80,7 @@ class ColorMapping:
         return [to_hex(c[:3]) for c in rgb]
 
 
-def scalar_colors(values, cmap: str = "viridis", vmin=None, vmax=None, label: str = ""):
+def scalar_colors(values, cmap: str = "viridis", vmin=None, vmax=None, label: str = "", show_clipped: bool = False):
     """Colour vertices by a scalar per vertex.
 
     Parameters
@@ -89,6 +93,9 @@ def scalar_colors(values, cmap: str = "viridis", vmin=None, vmax=None, label: st
         Range mapped onto the colour map; default the finite minimum and maximum of ``values``.
     label : str
         Caption for the colour bar.
+    show_clipped : bool
+        If True, the mapping's ``extend`` names the ends that some finite value lies past (its colour
+        bar then shows that those values were clipped); default ``"neither"``.
 
     Returns
     -------
@@ -105,11 +112,15 @@ def scalar_colors(values, cmap: str = "viridis", vmin=None, vmax=None, label: st
     if hi < lo:
         raise ValueError(f"vmax ({hi}) must not be below vmin ({lo})")
     _cmap(cmap)
-    mapping = ColorMapping(cmap=cmap if isinstance(cmap, str) else cmap.name, vmin=lo, vmax=hi, label=label)
+    low, high = show_clipped and bool((finite < lo).any()), show_clipped and bool((finite > hi).any())
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[low, high]
+    mapping = ColorMapping(cmap=cmap if isinstance(cmap, str) else cmap.name, vmin=lo, vmax=hi, label=label,
+                           extend=extend)
     return mapping(v), mapping
 
 
-def error_colors(V_pred, V_true, vmax=None, scale: float = 1.0, cmap: str = ERROR_CMAP, label: str = "error"):
+def error_colors(V_pred, V_true, vmax=None, scale: float = 1.0, cmap: str = ERROR_CMAP, label: str = "error",
+                 show_clipped: bool = False):
     """Colour vertices by their distance to the ground truth.
 
     Parameters
@@ -125,6 +136,9 @@ def error_colors(V_pred, V_true, vmax=None, scale: float = 1.0, cmap: str = ERRO
         Multiplies the distances (e.g. ``100 / bounding_box_diagonal`` for percent of diagonal).
     cmap : str
     label : str
+    show_clipped : bool
+        Mark the distances past ``vmax`` on the colour bar (``mapping.extend == "max"``); see
+        :func:`scalar_colors`.
 
     Returns
     -------
@@ -140,7 +154,7 @@ def error_colors(V_pred, V_true, vmax=None, scale: float = 1.0, cmap: str = ERRO
     except ValueError:
         raise ValueError(f"V_pred {P.shape} and V_true {T.shape} do not broadcast") from None
     errors = scale * np.linalg.norm(diff, axis=-1)
-    colors, mapping = scalar_colors(errors, cmap=cmap, vmin=0.0, vmax=vmax, label=label)
+    colors, mapping = scalar_colors(errors, cmap=cmap, vmin=0.0, vmax=vmax, label=label, show_clipped=show_clipped)
     return colors, mapping, errors
 
 

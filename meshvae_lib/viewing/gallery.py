@@ -10,9 +10,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from meshvae_lib.geometry.alignment import rigid_transform
 from meshvae_lib.validation import check_count, check_vertices
 
-__all__ = ["gallery_indices", "mesh_caption", "angular_stripes", "LABEL_UNITS"]
+__all__ = ["gallery_indices", "mesh_caption", "angular_stripes", "align_on_part", "LABEL_UNITS"]
 
 #: label-name suffixes that hold numbers, and the unit shown after the value in a caption.
 LABEL_UNITS = {"_deg": "°", "_pct": "%"}
@@ -81,3 +82,27 @@ def angular_stripes(rest, n_stripes: int = 8, colors=((0.75, 0.8, 0.88), (0.85, 
     y, z = rest[:, 1] - rest[:, 1].mean(), rest[:, 2] - rest[:, 2].mean()
     band = np.floor((np.arctan2(z, y) + np.pi) / (2 * np.pi) * int(n_stripes)).astype(int) % 2
     return np.asarray(colors, dtype=np.float64)[band]
+
+
+def align_on_part(vertices, reference, part) -> tuple[np.ndarray, np.ndarray]:
+    """Each mesh moved rigidly so that the vertices ``part`` best fit the reference, and the angle
+    of that rotation.
+
+    vertices : (M, n, 3) or (n, 3) float, the meshes; reference : (n, 3) float; part : (n,) bool,
+    at least 3 True, the vertices the rigid fit (Kabsch, no scale) uses -- a part that moves
+    rigidly (the back of a head) makes the angle that part's turn and leaves the rest's own motion
+    in the aligned mesh. Returns ``aligned`` (same shape as ``vertices``, float64: every vertex moved
+    by the fit of the part) and ``turn_deg`` ((M,) or () float64, the fitted rotation's angle in
+    degrees, in [0, 180]).
+    """
+    V = check_vertices(vertices, "vertices")
+    ref = check_vertices(reference, "reference", batch=False)
+    part = np.asarray(part)
+    if part.dtype != bool or part.shape != (ref.shape[0],) or part.sum() < 3:
+        raise ValueError(f"part must be ({ref.shape[0]},) bool with at least 3 True, got {part.dtype} {part.shape}")
+    if V.shape[-2:] != ref.shape:
+        raise ValueError(f"vertices {V.shape} and reference {ref.shape} must have the same vertices")
+    R, t = rigid_transform(V[..., part, :], ref[part])
+    aligned = V @ np.swapaxes(R, -1, -2) + t[..., None, :]
+    cos = (np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0
+    return aligned, np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))

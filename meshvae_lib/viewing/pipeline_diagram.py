@@ -26,7 +26,7 @@ class PipelineStep:
 
 #: the top row, left to right: from the meshes to the latent code.
 ENCODER_SIDE = (
-    PipelineStep("meshes $\\mathbf{p}'$\n(one connectivity,\nreference $\\mathbf{p}$)", "Sec. 3", "data_synth\ncollection_io", "00, 10"),
+    PipelineStep("meshes $\\mathbf{p}'$\n(one connectivity,\nreference $\\mathbf{p}$)", "Sec. 3", "data_synth\ncollection_io", "00, 11"),
     PipelineStep("deformation\ngradients $\\mathbf{T}_i$", "Eq. (1)", "deformation_gradient\ncotangent", "01"),
     PipelineStep("RIMD feature\n$\\{\\log dR_{ij};\\ \\mathbf{S}_i\\}$", "Eq. (2)", "rotations\nrimd", "02"),
     PipelineStep("normalised\nto [-0.9, 0.9]", "Eq. (3)", "normalization", "03"),

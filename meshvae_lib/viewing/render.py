@@ -359,7 +359,7 @@ def _add_colorbar(fig, colorbar: ColorMapping, bottom: float) -> None:
 
     cax = fig.add_axes([0.25, 0.62 * bottom, 0.5, 0.2 * bottom])
     sm = ScalarMappable(norm=Normalize(colorbar.vmin, colorbar.vmax), cmap=matplotlib.colormaps[colorbar.cmap])
-    cb = fig.colorbar(sm, cax=cax, orientation="horizontal")
+    cb = fig.colorbar(sm, cax=cax, orientation="horizontal", extend=colorbar.extend)
     cb.ax.tick_params(labelsize=8)
     if colorbar.label:
         cb.set_label(colorbar.label, fontsize=9)
