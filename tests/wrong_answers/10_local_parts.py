@@ -24,6 +24,11 @@ WRONG_ANSWERS = {
             '                                       seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
             'err_two = 2.8e-04\n'
         ),
+        'the model stored under another name than two (the exercise names it)': (
+            'm2 = MeshVAEModel("rimd", TrainConfig(architecture="local-parts", latent_dim=LATENT, network_options={"n_regions": 2},\n'
+            '                                      seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
+            "err_two = evaluate_model(m2, coll, indices=held)['mean_vertex_error']\n"
+        ),
         'measured on every mesh, training ones included': (
             'two = MeshVAEModel("rimd", TrainConfig(architecture="local-parts", latent_dim=LATENT, network_options={"n_regions": 2},\n'
             '                                       seed=SEED, device="cpu", progress=False), holdout_every=HOLDOUT_EVERY).fit(coll)\n'
