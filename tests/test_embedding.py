@@ -187,3 +187,20 @@ def test_auc_extremes_and_joint_relevance():
         ret.precision_recall_curve(Y, shape, relevance="both")
     with pytest.raises(ValueError, match=r"\(18,\)"):
         ret.precision_recall_curve(Y, shape[:5])
+
+
+def test_label_variance_share_separates_group_means_from_noise(rng):
+    label = np.repeat(np.arange(4), 50)
+    by_label = label.astype(float) * 3.0                       # constant within every group
+    noise = rng.normal(size=200)
+    noise_centred = noise - np.array([noise[label == g].mean() for g in range(4)])[label]   # every group mean 0
+    share = emb.label_variance_share(np.c_[by_label, noise_centred, by_label + noise, np.ones(200)], label)
+    assert share.shape == (4,) and share.dtype == np.float64
+    assert share[0] == pytest.approx(1.0) and share[1] == pytest.approx(0.0, abs=1e-12) and share[3] == 0.0
+    # between-group sum of squares over the total, computed by hand
+    col = by_label + noise
+    means = np.array([col[label == g].mean() for g in range(4)])
+    between = (50 * (means - col.mean()) ** 2).sum()
+    assert share[2] == pytest.approx(between / ((col - col.mean()) ** 2).sum())
+    with pytest.raises(ValueError, match="one value per row"):
+        emb.label_variance_share(np.zeros((5, 2)), np.arange(4))

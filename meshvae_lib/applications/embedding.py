@@ -9,7 +9,8 @@ precision-recall curve: ours 0.5168 > t-SNE 0.4961 > PCA 0.2272 > NPE 0.1391.
 Public names
 ------------
 ``NeighborhoodPreservingEmbedding`` (our implementation; no maintained Python package has it),
-``pca_embedding``, ``tsne_embedding``. The mesh VAE's embedding is the first encoder means of the
+``pca_embedding``, ``tsne_embedding``, ``label_variance_share`` (what share of each embedding
+direction's variance lies between the groups of a label: what a direction encodes). The mesh VAE's embedding is the first encoder means of the
 sigma_object model (``model.encode_meshes(coll)[:, :2]``; its prior: ``defaults.EMBEDDING_SIGMA_OBJECT``
 padded by ``train_config.pad_sigma_object``). Their retrieval scores:
 :mod:`~meshvae_lib.applications.retrieval`.
@@ -26,6 +27,7 @@ from meshvae_lib.validation import check_is_fitted, check_rows, check_samples
 
 __all__ = [
     "NeighborhoodPreservingEmbedding",
+    "label_variance_share",
     "pca_embedding",
     "tsne_embedding",
 ]
@@ -197,3 +199,26 @@ def tsne_embedding(
     perp = float(min(perplexity, max(1.0, (n - 1) / 3.0)))
     ts = TSNE(n_components=n_components, perplexity=perp, init="pca", random_state=seed)
     return ts.fit_transform(X).astype(np.float64)
+
+
+def label_variance_share(Y, label) -> np.ndarray:
+    """The share of each column's variance that lies between the groups of ``label`` (eta squared).
+
+    Y : (n, m) float, one row per sample (an embedding, or principal components); label : (n,) any
+    hashable values. Returns (m,) float64 in [0, 1]: 1 - (within-group sum of squares) / (total sum
+    of squares) per column; 1 where a column is constant within every group, 0 where every group has
+    the column's overall mean. A constant column gets 0.
+    """
+    Y = check_samples(Y)
+    label = np.asarray(label)
+    if label.shape != (len(Y),):
+        raise ValueError(f"label: one value per row of Y ({len(Y)}), got shape {label.shape}")
+    centred = Y - Y.mean(axis=0)
+    total = (centred ** 2).sum(axis=0)
+    _, group = np.unique(label, return_inverse=True)
+    within = np.zeros(Y.shape[1])
+    for g in range(group.max() + 1):
+        rows = Y[group == g]
+        within += ((rows - rows.mean(axis=0)) ** 2).sum(axis=0)
+    share = np.where(total > 0, 1.0 - within / np.where(total > 0, total, 1.0), 0.0)
+    return np.clip(share, 0.0, 1.0)
