@@ -8,19 +8,6 @@ _ENCODED = (
     'Zp = plain.encode_meshes(coll.vertices, inference="encoder")\n'
 )
 
-#: the solution of exercise 3 with the lesson's pair written in instead of SHAPE_A, SHAPE_B, BLEND_MOTION
-_BISECTION_WRITTEN_IN = (
-    'from meshvae_lib.model import per_vertex_error\n'
-    'z0 = np.zeros((1, cond.latent_dim))\n'
-    'c_a, c_b = (cond.condition_vector({"shape": s, "motion": "walk"}) for s in ("female_heavy", "male_tall_slim"))\n'
-    'V_a, V_b = cond.decode_latent(z0, conditions=c_a), cond.decode_latent(z0, conditions=c_b)\n'
-    'lo, hi = 0.0, 1.0\n'
-    'for _ in range(30):\n'
-    '    w_mid = (lo + hi) / 2\n'
-    '    V_w = cond.decode_latent(z0, conditions=(1 - w_mid) * c_a + w_mid * c_b)\n'
-    '    lo, hi = (w_mid, hi) if per_vertex_error(V_w, V_a).mean() < per_vertex_error(V_w, V_b).mean() else (lo, w_mid)\n'
-)
-
 #: the solution of exercise 3 with one of the pair or the motion written in (format with the three expressions)
 _BISECTION = (
     'from meshvae_lib.model import per_vertex_error\n'
@@ -33,6 +20,9 @@ _BISECTION = (
     '    V_w = cond.decode_latent(z0, conditions=(1 - w_mid) * c_a + w_mid * c_b)\n'
     '    lo, hi = (w_mid, hi) if per_vertex_error(V_w, V_a).mean() < per_vertex_error(V_w, V_b).mean() else (lo, w_mid)\n'
 )
+
+#: the solution of exercise 3 with the lesson's pair written in instead of SHAPE_A, SHAPE_B, BLEND_MOTION
+_BISECTION_WRITTEN_IN = _BISECTION.format(motion='"walk"', a='"female_heavy"', b='"male_tall_slim"')
 
 WRONG_ANSWERS = {
     1: {
